@@ -1,0 +1,149 @@
+// norm2tex_bake: normal map -> H_global (32-bit float TIFF) or an 8-bit PNG preview.
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "cli_arguments.hpp"
+#include "norm2tex/error.hpp"
+#include "norm2tex/height_atlas_baker.hpp"
+#include "norm2tex/image_io.hpp"
+#include "quiet_stderr.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: norm2tex_bake NORMAL_MAP -o OUT.(tiff|tif|png) [--mask M] [--convention "
+    "opengl|directx]\n"
+    "                     [--range 0,-1|-1,1|0,1] [--alpha A] [--sigma-fine S] [--sigma-coarse S]\n"
+    "                     [--percentile-low P] [--percentile-high P] [--boundary mirror|periodic]\n"
+    "                     [--apron-refinements N] [--quiet]\n"
+    "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels 0)\n"
+    "  OUT.png:       8-bit preview, the range's low end black and high end white\n"
+    "  Defaults are the paper's: convention opengl, range -1,1, alpha 0.2, sigma-fine 0.35,\n"
+    "  sigma-coarse 1.1, percentiles 0.05 / 99.95.\n";
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
+  norm2tex::BakeOptions options;
+  options.normal_map.convention =
+      norm2tex::parseNormalConvention(args.value("--convention", "opengl"));
+  options.range = norm2tex::parseHeightRange(args.value("--range", "-1,1"));
+  options.alpha = args.number("--alpha", options.alpha);
+  options.sigma_fine = args.number("--sigma-fine", options.sigma_fine);
+  options.sigma_coarse = args.number("--sigma-coarse", options.sigma_coarse);
+  options.percentile_low = args.number("--percentile-low", options.percentile_low);
+  options.percentile_high = args.number("--percentile-high", options.percentile_high);
+  options.integration.apron_refinements =
+      args.integer("--apron-refinements", options.integration.apron_refinements);
+  const std::string boundary = args.value("--boundary", "mirror");
+  if (boundary == "mirror") {
+    options.integration.boundary = norm2tex::PoissonBoundary::kMirror;
+  } else if (boundary == "periodic") {
+    options.integration.boundary = norm2tex::PoissonBoundary::kPeriodic;
+  } else {
+    throw norm2tex::Error("unknown --boundary '" + boundary + "'; valid: mirror, periodic");
+  }
+  norm2tex::validate(options);
+  return options;
+}
+
+/// The range's low end maps to 0, its high end to 255; invalid texels are 0.
+cv::Mat previewImage(const norm2tex::HeightAtlas& atlas, norm2tex::HeightRange range) {
+  const cv::Vec2f bounds = norm2tex::rangeBounds(range);
+  cv::Mat preview;
+  atlas.heights().convertTo(preview, CV_8U, 255.0 / (bounds[1] - bounds[0]),
+                            -255.0 * bounds[0] / (bounds[1] - bounds[0]));
+  preview.setTo(0, atlas.valid() == 0);
+  return preview;
+}
+
+int run(int argc, char** argv) {
+  const norm2tex::cli::Arguments args(
+      argc, argv,
+      {"-o", "--output", "--mask", "--convention", "--range", "--alpha", "--sigma-fine",
+       "--sigma-coarse", "--percentile-low", "--percentile-high", "--boundary",
+       "--apron-refinements"},
+      {"--quiet", "-h", "--help"});
+  if (args.flag("-h") || args.flag("--help")) {
+    std::cout << kUsage;
+    return 0;
+  }
+  if (args.positional().size() != 1) {
+    throw norm2tex::cli::UsageError("expected exactly one NORMAL_MAP argument");
+  }
+  const std::string output = args.value("-o", args.value("--output", ""));
+  if (output.empty()) throw norm2tex::cli::UsageError("missing -o OUT");
+  const std::string extension = norm2tex::lowerCaseExtension(output);
+  if (extension != ".tiff" && extension != ".tif" && extension != ".png") {
+    throw norm2tex::cli::UsageError("OUT must end in .tiff, .tif or .png, got '" + output + "'");
+  }
+  const bool quiet = args.flag("--quiet");
+  const norm2tex::BakeOptions options = parseOptions(args);
+
+  const auto start = Clock::now();
+  const norm2tex::NormalMap normal_map = [&] {
+    const norm2tex::cli::QuietStderr quiet_decoders;
+    return norm2tex::NormalMap::load(args.positional()[0], options.normal_map,
+                                     args.value("--mask", ""));
+  }();
+  const double load_seconds = secondsSince(start);
+
+  // Progress only where a bake takes long enough to wonder (about 1 Mtexel and up).
+  const bool show_progress = !quiet && normal_map.rows() * normal_map.cols() >= 1024 * 1024;
+  int last_percent = -1;
+  const auto progress = [&](double fraction) {
+    const int percent = static_cast<int>(fraction * 100.0);
+    if (percent / 5 == last_percent / 5) return;
+    last_percent = percent;
+    std::fprintf(stderr, "\rbaking: %3d%%", percent);
+    if (percent >= 100) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+
+  const auto bake_start = Clock::now();
+  norm2tex::BakeReport report;
+  const norm2tex::HeightAtlas atlas = norm2tex::bakeHeightAtlas(
+      normal_map, options, show_progress ? norm2tex::BakeProgress(progress) : nullptr, &report);
+  const double bake_seconds = secondsSince(bake_start);
+
+  if (extension == ".png") {
+    norm2tex::writeImage(output, previewImage(atlas, options.range));
+  } else {
+    norm2tex::writeImage(output, atlas.heights());
+  }
+  if (!quiet) {
+    std::printf("%s: %dx%d texels, %d valid, %d UV island%s\n", args.positional()[0].c_str(),
+                normal_map.cols(), normal_map.rows(), report.valid_texels, report.island_count,
+                report.island_count == 1 ? "" : "s");
+    std::printf("range %s, percentiles %.2f/%.2f at %.6g/%.6g\n",
+                norm2tex::toString(options.range).c_str(), options.percentile_low,
+                options.percentile_high, report.percentile_values[0], report.percentile_values[1]);
+    std::printf("load %.3f s, bake %.3f s, total %.3f s -> %s\n", load_seconds, bake_seconds,
+                secondsSince(start), output.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const norm2tex::cli::UsageError& e) {
+    std::fprintf(stderr, "norm2tex_bake: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::string reason = e.what();  // one line, even when OpenCV's message has several
+    for (char& c : reason) c = (c == '\n' || c == '\r') ? ' ' : c;
+    std::fprintf(stderr, "norm2tex_bake: error: %s\n", reason.c_str());
+    return 1;
+  }
+}

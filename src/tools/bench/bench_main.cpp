@@ -1,0 +1,13 @@
+// norm2tex_bench: Google Benchmark executable shared by every stage of the pipeline.
+// OpenCV is pinned to one thread so the figures are "one core of this machine".
+#include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+
+int main(int argc, char** argv) {
+  cv::setNumThreads(1);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

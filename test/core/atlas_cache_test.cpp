@@ -1,0 +1,144 @@
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "norm2tex/analytic_surface.hpp"
+#include "norm2tex/atlas_cache.hpp"
+#include "norm2tex/error.hpp"
+#include "norm2tex/normal_encoding.hpp"
+#include "test_helpers.hpp"
+
+namespace norm2tex {
+namespace {
+namespace fs = std::filesystem;
+
+class AtlasCacheTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    const cv::Size size(64, 48);
+    AnalyticSurface s = makeWaves(size, {{2.0, 21.0, 0.4, 0.0}});
+    s += makeBumps(size, {{{20, 20}, 5, 4}});
+    normal_map_path_ = dir_.path("normal.png");
+    ASSERT_TRUE(cv::imwrite(normal_map_path_,
+                            encodeNormalMap(s.dx, s.dy, NormalConvention::kOpenGL, CV_8U)));
+  }
+  std::string readFile(const std::string& path) {
+    std::ifstream file(path);
+    std::stringstream text;
+    text << file.rdbuf();
+    return text.str();
+  }
+  test::ScratchDirectory dir_;
+  std::string normal_map_path_;
+};
+
+TEST_F(AtlasCacheTest, SecondLoadComesFromTheCacheBitForBit) {
+  const AtlasCache cache(dir_.path("cache"));
+  const AtlasCache::Result first = cache.loadOrBake(normal_map_path_, "", {});
+  EXPECT_FALSE(first.was_cached);
+  EXPECT_TRUE(first.store_error.empty()) << first.store_error;
+  const AtlasCache::Result second = cache.loadOrBake(normal_map_path_, "", {});
+  EXPECT_TRUE(second.was_cached);
+  EXPECT_EQ(cv::norm(first.atlas.heights(), second.atlas.heights(), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(first.atlas.valid() != second.atlas.valid()), 0);
+  EXPECT_EQ(second.atlas.islandCount(), first.atlas.islandCount());
+}
+
+TEST_F(AtlasCacheTest, MetadataRecordsSourceConventionAndParameters) {
+  const AtlasCache cache(dir_.path("cache"));
+  BakeOptions options;
+  options.normal_map.convention = NormalConvention::kDirectX;
+  options.range = HeightRange::kRemove;
+  cache.loadOrBake(normal_map_path_, "", options);
+  const std::string yaml =
+      readFile(dir_.path("cache/" + cache.key(normal_map_path_, "", options) + ".yaml"));
+  EXPECT_NE(yaml.find("source_hash"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("normal.png"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("directx"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("sigma_fine=0.34999"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("0,-1"), std::string::npos) << yaml;
+}
+
+TEST_F(AtlasCacheTest, KeyFollowsContentAndEveryOption) {
+  const AtlasCache cache(dir_.path("cache"));
+  const std::string base = cache.key(normal_map_path_, "", {});
+  EXPECT_EQ(base, cache.key(normal_map_path_, "", {})) << "stable";
+  // Same bytes under another name: same entry.
+  fs::copy_file(normal_map_path_, dir_.path("renamed.png"));
+  EXPECT_EQ(base, cache.key(dir_.path("renamed.png"), "", {}));
+  BakeOptions o;
+  o.alpha = 0.3;
+  EXPECT_NE(base, cache.key(normal_map_path_, "", o));
+  o = {};
+  o.normal_map.convention = NormalConvention::kDirectX;
+  EXPECT_NE(base, cache.key(normal_map_path_, "", o));
+  o = {};
+  o.range = HeightRange::kAdd;
+  EXPECT_NE(base, cache.key(normal_map_path_, "", o));
+  // One changed byte in the image file: a different entry.
+  cv::Mat image = cv::imread(normal_map_path_, cv::IMREAD_UNCHANGED);
+  image.at<cv::Vec3b>(3, 3)[0] ^= 1;
+  cv::imwrite(normal_map_path_, image);
+  EXPECT_NE(base, cache.key(normal_map_path_, "", {}));
+}
+
+TEST_F(AtlasCacheTest, DamagedEntryIsAMissAndGetsReplaced) {
+  const AtlasCache cache(dir_.path("cache"));
+  cache.loadOrBake(normal_map_path_, "", {});
+  const std::string key = cache.key(normal_map_path_, "", {});
+  std::ofstream(dir_.path("cache/" + key + ".tiff"), std::ios::trunc) << "garbage";
+  EXPECT_FALSE(cache.load(key).has_value());
+  const AtlasCache::Result again = cache.loadOrBake(normal_map_path_, "", {});
+  EXPECT_FALSE(again.was_cached);
+  EXPECT_TRUE(cache.load(key).has_value());
+}
+
+TEST_F(AtlasCacheTest, EntryWithoutMetadataDoesNotCount) {
+  // The yaml is written last: without it, an interrupted store is invisible.
+  const AtlasCache cache(dir_.path("cache"));
+  cache.loadOrBake(normal_map_path_, "", {});
+  const std::string key = cache.key(normal_map_path_, "", {});
+  fs::remove(dir_.path("cache/" + key + ".yaml"));
+  EXPECT_FALSE(cache.load(key).has_value());
+}
+
+TEST_F(AtlasCacheTest, UnwritableCacheStillReturnsTheAtlas) {
+  if (geteuid() == 0) {
+    // root ignores permissions: use a path under a regular file instead.
+    std::ofstream(dir_.path("not_a_dir")) << "x";
+  } else {
+    fs::create_directory(dir_.path("not_a_dir"));
+    fs::permissions(dir_.path("not_a_dir"), fs::perms::owner_read | fs::perms::owner_exec);
+  }
+  const AtlasCache cache(dir_.path("not_a_dir/cache"));
+  const AtlasCache::Result result = cache.loadOrBake(normal_map_path_, "", {});
+  EXPECT_FALSE(result.atlas.empty());
+  EXPECT_FALSE(result.store_error.empty());
+  EXPECT_FALSE(result.was_cached);
+}
+
+TEST_F(AtlasCacheTest, MissingNormalMapIsAClearError) {
+  const AtlasCache cache(dir_.path("cache"));
+  try {
+    cache.loadOrBake(dir_.path("nope.png"), "", {});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nope.png"), std::string::npos) << e.what();
+  }
+}
+
+TEST(AtlasCacheDirectory, EnvironmentChoosesTheDefault) {
+  setenv("NORM2TEX_CACHE_DIR", "/tmp/explicit_cache", 1);
+  EXPECT_EQ(AtlasCache::defaultDirectory(), "/tmp/explicit_cache");
+  unsetenv("NORM2TEX_CACHE_DIR");
+  setenv("XDG_CACHE_HOME", "/tmp/xdg", 1);
+  EXPECT_EQ(AtlasCache::defaultDirectory(), "/tmp/xdg/norm2tex");
+  unsetenv("XDG_CACHE_HOME");
+}
+
+}  // namespace
+}  // namespace norm2tex

@@ -1,0 +1,44 @@
+#pragma once
+// Shared helpers of the core tests: statistics against analytic truth and scratch directories.
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "norm2tex/analytic_surface.hpp"
+#include "norm2tex/normal_map.hpp"
+
+namespace norm2tex {
+namespace test {
+
+/// Pearson correlation of a and b over the texels where mask != 0.
+double correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask);
+
+/// The surface's height minus the plane of its mean slope over `mask`: what a bake with
+/// remove_mean_slope reconstructs (up to scale and offset).
+cv::Mat1f withoutMeanSlope(const AnalyticSurface& surface, const cv::Mat1b& mask);
+
+/// Standard deviation of a over the texels where mask != 0.
+double maskedStdDev(const cv::Mat1f& a, const cv::Mat1b& mask);
+
+/// Encodes a surface's exact gradients at `depth` (CV_8U / CV_16U) and decodes the image
+/// again, the way a normal map file would arrive.
+NormalMap quantisedNormalMap(const AnalyticSurface& surface, const cv::Mat1b& mask, int depth,
+                             NormalConvention convention = NormalConvention::kOpenGL);
+
+/// A fresh directory under the system temp dir, removed with its content on destruction.
+class ScratchDirectory {
+ public:
+  ScratchDirectory();
+  ~ScratchDirectory();
+  ScratchDirectory(const ScratchDirectory&) = delete;
+  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
+  std::string path(const std::string& name) const;
+  const std::string& root() const { return root_; }
+
+ private:
+  std::string root_;
+};
+
+}  // namespace test
+}  // namespace norm2tex

@@ -1,0 +1,112 @@
+// Runs the real norm2tex_bake executable: outputs, exit codes and one-line errors.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "norm2tex/analytic_surface.hpp"
+#include "norm2tex/normal_encoding.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+CliRun bake(const std::string& arguments) {
+  const std::string command = std::string(NORM2TEX_BAKE_EXECUTABLE) + " " + arguments + " 2>&1";
+  CliRun run{-1, ""};
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  char buffer[4096];
+  while (fgets(buffer, sizeof(buffer), pipe) != nullptr) run.output += buffer;
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+class BakeCli : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("norm2tex_bake_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    const cv::Size size(96, 64);
+    norm2tex::AnalyticSurface s = norm2tex::makeWaves(size, {{2.0, 30.0, 0.5, 0.0}});
+    const cv::Mat1b mask = norm2tex::makeIslandMask(size, 2, 4);
+    cv::imwrite(
+        path("normal.png"),
+        norm2tex::encodeNormalMap(s.dx, s.dy, norm2tex::NormalConvention::kOpenGL, CV_16U, mask));
+    cv::imwrite(path("mask.png"), mask);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+TEST_F(BakeCli, WritesAFloatTiffOfTheMapsSize) {
+  const CliRun run =
+      bake(path("normal.png") + " --mask " + path("mask.png") + " -o " + path("h.tiff"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("4 UV islands"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("bake "), std::string::npos) << "reports the time: " << run.output;
+  const cv::Mat h = cv::imread(path("h.tiff"), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(h.type(), CV_32FC1);
+  EXPECT_EQ(h.size(), cv::Size(96, 64));
+  double low, high;
+  cv::minMaxLoc(h, &low, &high);
+  EXPECT_FLOAT_EQ(low, -1.0f);
+  EXPECT_FLOAT_EQ(high, 1.0f);
+}
+
+TEST_F(BakeCli, RangeAndPngPreview) {
+  ASSERT_EQ(bake(path("normal.png") + " --range 0,1 -o " + path("h.tif")).exit_code, 0);
+  double low, high;
+  cv::minMaxLoc(cv::imread(path("h.tif"), cv::IMREAD_UNCHANGED), &low, &high);
+  EXPECT_FLOAT_EQ(low, 0.0f);
+  EXPECT_FLOAT_EQ(high, 1.0f);
+  ASSERT_EQ(bake(path("normal.png") + " --quiet -o " + path("preview.png")).exit_code, 0);
+  const cv::Mat preview = cv::imread(path("preview.png"), cv::IMREAD_UNCHANGED);
+  EXPECT_EQ(preview.type(), CV_8UC1);
+  cv::minMaxLoc(preview, &low, &high);
+  EXPECT_EQ(high, 255.0);
+}
+
+TEST_F(BakeCli, BadInputExitsNonZeroWithOneLineReason) {
+  std::ofstream(path("empty.png")).close();
+  std::ofstream(path("corrupt.png")) << "\x89PNG\r\n\x1a\ngarbage";
+  cv::imwrite(path("gray.png"), cv::Mat(8, 8, CV_8UC1, cv::Scalar(9)));
+  cv::imwrite(path("transparent.png"), cv::Mat(8, 8, CV_8UC4, cv::Scalar(255, 128, 128, 0)));
+  for (const std::string input :
+       {"missing.png", "empty.png", "corrupt.png", "gray.png", "transparent.png"}) {
+    const CliRun run = bake(path(input) + " -o " + path("out.tiff"));
+    EXPECT_EQ(run.exit_code, 1) << input << ": " << run.output;
+    EXPECT_EQ(run.output.rfind("norm2tex_bake: error: ", 0), 0u) << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+    EXPECT_FALSE(fs::exists(path("out.tiff"))) << "no output for bad input";
+  }
+}
+
+TEST_F(BakeCli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(bake(path("normal.png")).exit_code, 2) << "no -o";
+  EXPECT_EQ(bake(path("normal.png") + " -o " + path("x.jpg")).exit_code, 2) << "bad extension";
+  EXPECT_EQ(bake(path("normal.png") + " --alpha lots -o " + path("x.tiff")).exit_code, 2);
+  EXPECT_EQ(bake(path("normal.png") + " --frobnicate -o " + path("x.tiff")).exit_code, 2);
+  EXPECT_EQ(bake(path("normal.png") + " --alpha 3 -o " + path("x.tiff")).exit_code, 1)
+      << "a number out of range is a parameter error";
+  EXPECT_EQ(bake(path("normal.png") + " --convention vulkan -o " + path("x.tiff")).exit_code, 1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
