@@ -200,5 +200,29 @@ TEST(NormalMap, LoadsSixteenBitRgbaFromDisk) {
   EXPECT_EQ(map.valid()(2, 3), 0);
 }
 
+TEST(NormalMap, LoadsTiffAndJpegLikePng) {
+  // The same relief through 16-bit TIFF, 8-bit PNG and JPEG (lossy, so only close).
+  test::ScratchDirectory dir;
+  const cv::Size size(64, 40);
+  const AnalyticSurface s = makeWaves(size, {{1.5, 20.0, 0.5, 0.0}});
+  ASSERT_TRUE(cv::imwrite(dir.path("n.tiff"),
+                          encodeNormalMap(s.dx, s.dy, NormalConvention::kOpenGL, CV_16U)));
+  const cv::Mat image8 = encodeNormalMap(s.dx, s.dy, NormalConvention::kOpenGL, CV_8U);
+  ASSERT_TRUE(cv::imwrite(dir.path("n.png"), image8));
+  ASSERT_TRUE(cv::imwrite(dir.path("n.jpg"), image8, {cv::IMWRITE_JPEG_QUALITY, 98}));
+  const NormalMap tiff = NormalMap::load(dir.path("n.tiff"));
+  const NormalMap png = NormalMap::load(dir.path("n.png"));
+  const NormalMap jpeg = NormalMap::load(dir.path("n.jpg"));
+  EXPECT_EQ(tiff.rows(), 40);
+  EXPECT_EQ(tiff.cols(), 64);
+  EXPECT_LT(cv::norm(tiff.normals(), png.normals(), cv::NORM_INF), 0.01);
+  // JPEG subsamples chroma: single texels stray, the average stays close.
+  const double jpeg_mean_error =
+      cv::norm(tiff.normals(), jpeg.normals(), cv::NORM_L1) / (3.0 * 64 * 40);
+  EXPECT_LT(jpeg_mean_error, 0.01);
+  EXPECT_LT(cv::norm(tiff.normals(), jpeg.normals(), cv::NORM_INF), 0.15);
+  EXPECT_EQ(jpeg.validCount(), 64 * 40);
+}
+
 }  // namespace
 }  // namespace norm2tex
