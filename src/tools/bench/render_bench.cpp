@@ -1,0 +1,111 @@
+// Per-frame cost of the DIGIT renderer at 320 x 240 (one core): whole frames with and without
+// texture, a 200k-triangle mesh, and each stage on its own.
+#include <memory>
+
+#include <benchmark/benchmark.h>
+
+#include "norm2tex/analytic_surface.hpp"
+#include "norm2tex/contact_rasterizer.hpp"
+#include "norm2tex/gel_model.hpp"
+#include "norm2tex/height_atlas_baker.hpp"
+#include "norm2tex/mesh_primitives.hpp"
+#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/tactile_renderer.hpp"
+#include "norm2tex/texture_overlay.hpp"
+
+namespace {
+
+// The reference scene: a 10 mm sphere pressed 1 mm at the gel centre.
+Eigen::Isometry3d pressedSphere() {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(0.0003, -0.0002, 0.005 - 0.001);
+  return pose;
+}
+
+std::shared_ptr<const norm2tex::TexturedMesh> sphere(int rings, int segments) {
+  return std::make_shared<norm2tex::TexturedMesh>(norm2tex::makeUvSphere(0.005, rings, segments));
+}
+
+std::shared_ptr<const norm2tex::HeightAtlas> atlas() {
+  static const auto baked = [] {
+    const cv::Size size(1024, 1024);
+    norm2tex::AnalyticSurface s = norm2tex::makeWaves(size, {{1.0, 37.0, 0.4, 0.0}});
+    s += norm2tex::makeRidges(size, {1.2, 11.0, 1.5, 0.8});
+    const cv::Mat image =
+        norm2tex::encodeNormalMap(s.dx, s.dy, norm2tex::NormalConvention::kOpenGL, CV_8U);
+    return std::make_shared<const norm2tex::HeightAtlas>(
+        norm2tex::bakeHeightAtlas(norm2tex::NormalMap::fromImage(image)));
+  }();
+  return baked;
+}
+
+void renderLoop(benchmark::State& state, std::shared_ptr<const norm2tex::TexturedMesh> mesh,
+                double beta_mm, std::int64_t seed) {
+  norm2tex::TactileRenderer renderer(norm2tex::makeDigitSensorModel());
+  renderer.setObject(std::move(mesh), beta_mm > 0 ? atlas() : nullptr, beta_mm);
+  const Eigen::Isometry3d pose = pressedSphere();
+  int frame = 0;
+  for (auto _ : state) {
+    const norm2tex::TactileFrame& out = renderer.render(pose, seed < 0 ? -1 : seed + frame++);
+    benchmark::DoNotOptimize(out.image.data);
+  }
+  state.counters["fps"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_Render_Textureless(benchmark::State& state) { renderLoop(state, sphere(96, 192), 0.0, 1); }
+void BM_Render_Textured(benchmark::State& state) { renderLoop(state, sphere(96, 192), 0.2, 1); }
+void BM_Render_Textured_200kTriangles(benchmark::State& state) {
+  renderLoop(state, sphere(317, 317), 0.2, 1);
+}
+
+// --- stages ---------------------------------------------------------------------------------
+struct StageFixture {
+  norm2tex::SensorModel model = norm2tex::makeDigitSensorModel();
+  std::shared_ptr<const norm2tex::TexturedMesh> mesh = sphere(96, 192);
+  norm2tex::ContactRasterizer rasterizer{model};
+  norm2tex::TextureOverlay overlay{atlas(), 0.2};
+  norm2tex::GelModel gel{model};
+  norm2tex::ContactRaster raster;
+  cv::Mat1f h_final, gel_mm;
+  StageFixture() {
+    rasterizer.rasterize(*mesh, pressedSphere(), overlay.reachMm(), true, raster);
+    overlay.apply(raster, model.gel_thickness_mm, h_final);
+    gel.apply(h_final, gel_mm);
+  }
+};
+
+void BM_Stage_Raster(benchmark::State& state) {
+  StageFixture f;
+  const bool want_uv = state.range(0) != 0;
+  for (auto _ : state)
+    f.rasterizer.rasterize(*f.mesh, pressedSphere(), want_uv ? f.overlay.reachMm() : 0.0, want_uv,
+                           f.raster);
+}
+void BM_Stage_Overlay(benchmark::State& state) {
+  StageFixture f;
+  for (auto _ : state) f.overlay.apply(f.raster, f.model.gel_thickness_mm, f.h_final);
+}
+void BM_Stage_Gel(benchmark::State& state) {
+  StageFixture f;
+  for (auto _ : state) f.gel.apply(f.h_final, f.gel_mm);
+}
+void BM_Stage_Shading(benchmark::State& state) {
+  StageFixture f;
+  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()));
+  const bool noise = state.range(0) != 0;
+  std::int64_t seed = 0;
+  for (auto _ : state) {
+    cv::Mat3b image = shader.shade(f.gel_mm, noise ? seed++ : -1);
+    benchmark::DoNotOptimize(image.data);
+  }
+}
+
+BENCHMARK(BM_Render_Textureless)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Render_Textured)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Render_Textured_200kTriangles)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Stage_Raster)->ArgName("uv")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Overlay)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Gel)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Shading)->ArgName("noise")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+}  // namespace

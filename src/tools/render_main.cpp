@@ -1,0 +1,178 @@
+// norm2tex_render: one DIGIT frame of a mesh pressed into the gel, with or without texture.
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "cli_arguments.hpp"
+#include "norm2tex/atlas_cache.hpp"
+#include "norm2tex/error.hpp"
+#include "norm2tex/image_io.hpp"
+#include "norm2tex/mesh_primitives.hpp"
+#include "norm2tex/tactile_renderer.hpp"
+#include "quiet_stderr.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: norm2tex_render --mesh M --pose \"x y z roll pitch yaw\" [--press-mm D]\n"
+    "                       [--normal-map N.png | --atlas H.tiff] [--beta MM] [--scale S]\n"
+    "                       [--sensor digit.yaml] [--background BG.png] [--seed S] [--no-noise]\n"
+    "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
+    "  --mesh: a mesh file (OBJ, STL, PLY, DAE, glTF/GLB) or a primitive: sphere:<radius_mm>,\n"
+    "          box:<x_mm>x<y_mm>x<z_mm>\n"
+    "  --pose: the object in the gel frame, metres and radians (roll, pitch, yaw about fixed\n"
+    "          x, y, z). Gel frame: origin at the centre of the undeformed gel surface, +x\n"
+    "          right (image columns), +y down (image rows), +z out of the gel towards the\n"
+    "          object. An object whose lowest point is at z = 0 just touches.\n"
+    "  --press-mm D: then move the object D mm along -z, into the gel.\n"
+    "  --normal-map: baked to H_global (cached on disk); --atlas: an H_global float TIFF.\n"
+    "          Without either, the mesh's own normal texture (glTF/OBJ material) is used.\n"
+    "  --beta: texture depth in mm (default 0.2 when a texture is given; 0 = textureless).\n"
+    "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
+    "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n";
+
+std::shared_ptr<const norm2tex::TexturedMesh> loadMesh(const std::string& spec, double scale) {
+  if (spec.rfind("sphere:", 0) == 0) {
+    std::istringstream text(spec.substr(7));
+    double radius_mm = 0;
+    if (!(text >> radius_mm) || !(radius_mm > 0)) {
+      throw norm2tex::cli::UsageError("--mesh sphere:<radius_mm>, got '" + spec + "'");
+    }
+    return std::make_shared<norm2tex::TexturedMesh>(
+        norm2tex::makeUvSphere(radius_mm * 1e-3, 96, 192));
+  }
+  if (spec.rfind("box:", 0) == 0) {
+    double x = 0, y = 0, z = 0;
+    char sep1 = 0, sep2 = 0;
+    std::istringstream sizes(spec.substr(4));
+    if (!(sizes >> x >> sep1 >> y >> sep2 >> z) || sep1 != 'x' || sep2 != 'x') {
+      throw norm2tex::cli::UsageError("--mesh box:<x_mm>x<y_mm>x<z_mm>, got '" + spec + "'");
+    }
+    return std::make_shared<norm2tex::TexturedMesh>(
+        norm2tex::makeBox(Eigen::Vector3d(x, y, z) * 1e-3, 0.02));
+  }
+  norm2tex::MeshLoadOptions options;
+  options.scale = scale;
+  return std::make_shared<norm2tex::TexturedMesh>(norm2tex::TexturedMesh::load(spec, options));
+}
+
+Eigen::Isometry3d parsePose(const std::string& text, double press_mm) {
+  std::istringstream in(text);
+  double v[6];
+  for (double& value : v) {
+    if (!(in >> value)) {
+      throw norm2tex::cli::UsageError("--pose needs 6 numbers \"x y z roll pitch yaw\", got '" +
+                                      text + "'");
+    }
+  }
+  std::string extra;
+  if (in >> extra)
+    throw norm2tex::cli::UsageError("--pose has more than 6 numbers: '" + text + "'");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(v[5], Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(v[4], Eigen::Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(v[3], Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(v[0], v[1], v[2] - press_mm * 1e-3);
+  if (!pose.matrix().allFinite()) throw norm2tex::Error("--pose is not finite: '" + text + "'");
+  return pose;
+}
+
+std::shared_ptr<const norm2tex::HeightAtlas> loadAtlas(const norm2tex::cli::Arguments& args,
+                                                       const norm2tex::TexturedMesh& mesh) {
+  if (const auto atlas_path = args.value("--atlas")) {
+    const cv::Mat heights = norm2tex::readImage(*atlas_path, cv::IMREAD_UNCHANGED, "atlas");
+    if (heights.type() != CV_32FC1) {
+      throw norm2tex::Error(
+          "atlas '" + *atlas_path +
+          "' must be a single-channel 32-bit float TIFF (norm2tex_bake -o X.tiff)");
+    }
+    return std::make_shared<norm2tex::HeightAtlas>(heights, cv::Mat1b(heights.size(), 255));
+  }
+  std::string normal_map = args.value("--normal-map", mesh.normalTexturePath());
+  if (normal_map.empty()) return nullptr;
+  const norm2tex::AtlasCache cache(norm2tex::AtlasCache::defaultDirectory());
+  norm2tex::AtlasCache::Result result = cache.loadOrBake(normal_map, "", {});
+  if (!result.store_error.empty()) {
+    std::fprintf(stderr, "norm2tex_render: warning: %s\n", result.store_error.c_str());
+  }
+  return std::make_shared<norm2tex::HeightAtlas>(std::move(result.atlas));
+}
+
+int run(int argc, char** argv) {
+  const norm2tex::cli::Arguments args(
+      argc, argv,
+      {"--mesh", "--pose", "--press-mm", "--normal-map", "--atlas", "--beta", "--scale", "--sensor",
+       "--background", "--seed", "-o", "--depth-out", "--mask-out"},
+      {"--no-noise", "-h", "--help"});
+  if (args.flag("-h") || args.flag("--help")) {
+    std::cout << kUsage;
+    return 0;
+  }
+  if (!args.has("--mesh")) throw norm2tex::cli::UsageError("missing --mesh");
+  if (!args.has("--pose")) throw norm2tex::cli::UsageError("missing --pose");
+  const std::string output = args.value("-o", "");
+  if (output.empty()) throw norm2tex::cli::UsageError("missing -o OUT.png");
+  if (args.has("--normal-map") && args.has("--atlas")) {
+    throw norm2tex::cli::UsageError("give --normal-map or --atlas, not both");
+  }
+
+  norm2tex::SensorModel model = args.has("--sensor")
+                                    ? norm2tex::loadSensorModel(*args.value("--sensor"))
+                                    : norm2tex::makeDigitSensorModel();
+  if (const auto background = args.value("--background")) model.background_image = *background;
+  const auto pose = parsePose(*args.value("--pose"), args.number("--press-mm", 0.0));
+  const auto mesh = [&] {
+    const norm2tex::cli::QuietStderr quiet_decoders;
+    return loadMesh(*args.value("--mesh"), args.number("--scale", 1.0));
+  }();
+  const auto atlas = [&] {
+    const norm2tex::cli::QuietStderr quiet_decoders;
+    return loadAtlas(args, *mesh);
+  }();
+  const double beta = args.number("--beta", atlas ? 0.2 : 0.0);
+
+  norm2tex::TactileRenderer renderer(model);
+  const std::string warning = renderer.setObject(mesh, atlas, beta);
+  if (!warning.empty()) std::fprintf(stderr, "norm2tex_render: warning: %s\n", warning.c_str());
+  const std::int64_t seed = args.flag("--no-noise") ? -1 : args.integer("--seed", 0);
+
+  const auto start = std::chrono::steady_clock::now();
+  const norm2tex::TactileFrame& frame = renderer.render(pose, seed);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+
+  norm2tex::writeImage(output, frame.image);
+  if (const auto depth_out = args.value("--depth-out"))
+    norm2tex::writeImage(*depth_out, frame.depthMetres());
+  if (const auto mask_out = args.value("--mask-out"))
+    norm2tex::writeImage(*mask_out, frame.contact_mask);
+  std::printf(
+      "%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
+      cv::countNonZero(frame.contact_mask),
+      frame.textured ? ("textured, beta " + std::to_string(beta) + " mm").c_str() : "textureless",
+      frame.raster.triangles_rasterized, ms);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const norm2tex::cli::UsageError& e) {
+    std::fprintf(stderr, "norm2tex_render: %s\n%s", e.what(), kUsage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::string reason = e.what();
+    for (char& c : reason) c = (c == '\n' || c == '\r') ? ' ' : c;
+    std::fprintf(stderr, "norm2tex_render: error: %s\n", reason.c_str());
+    return 1;
+  }
+}
