@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cmath>
+
 #include <opencv2/core.hpp>
 
 namespace norm2tex {
@@ -28,7 +30,33 @@ class HeightAtlas {
   HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, UvWrap wrap = UvWrap::kRepeat);
 
   /// H_global at (u, v); `valid` (optional) tells whether any texel of an island was found.
-  float sample(double u, double v, bool* valid = nullptr) const;
+  /// Inline: the renderer calls it for every contact pixel of every frame.
+  float sample(double u, double v, bool* valid = nullptr) const {
+    if (valid != nullptr) *valid = false;
+    if (heights_.empty() || !std::isfinite(u) || !std::isfinite(v)) return 0.0f;
+    if (wrap_ == UvWrap::kRepeat) {
+      u -= floorToInt(u);
+      v -= floorToInt(v);
+    } else {
+      u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+      v = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+    }
+    // Continuous texel coordinates with texel centres at integers; row 0 is v = 1.
+    const double x = u * heights_.cols - 0.5;
+    const double y = (1.0 - v) * heights_.rows - 0.5;
+    const int x0 = floorToInt(x), y0 = floorToInt(y);
+    const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+    // Fast path: the four texels are neighbours inside one island, away from the map's edge.
+    if (x0 >= 0 && y0 >= 0 && x0 + 1 < heights_.cols && y0 + 1 < heights_.rows &&
+        interior_(y0, x0)) {
+      if (valid != nullptr) *valid = true;
+      const float* top = heights_.ptr<float>(y0) + x0;
+      const float* bottom = heights_.ptr<float>(y0 + 1) + x0;
+      return (1 - fy) * ((1 - fx) * top[0] + fx * top[1]) +
+             fy * ((1 - fx) * bottom[0] + fx * bottom[1]);
+    }
+    return sampleAcrossBorder(x0, y0, fx, fy, valid);
+  }
 
   bool empty() const { return heights_.empty(); }
   int rows() const { return heights_.rows; }
@@ -42,11 +70,26 @@ class HeightAtlas {
   void setWrap(UvWrap wrap) { wrap_ = wrap; }
 
  private:
-  int wrapIndex(int index, int size) const;
+  /// `index` in [-1, size]: one texel off either edge at most.
+  int wrapIndex(int index, int size) const {
+    if (index < 0) return wrap_ == UvWrap::kClamp ? 0 : size - 1;
+    if (index >= size) return wrap_ == UvWrap::kClamp ? size - 1 : 0;
+    return index;
+  }
+  /// floor() without a libm call (baseline x86-64 has no rounding instruction); |x| < 2^31.
+  static int floorToInt(double x) {
+    const int truncated = static_cast<int>(x);
+    return truncated - (x < truncated ? 1 : 0);
+  }
+  /// Bilinear look-up near an island's border or the map's edge (x0, y0 in [-1, size - 1]).
+  float sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const;
 
   cv::Mat1f heights_;
   cv::Mat1b valid_;
   cv::Mat1i labels_;
+  /// 1 where texel (r, c) and its right, lower and lower-right neighbours are all in one
+  /// island: there a look-up is a plain bilinear blend, the common case.
+  cv::Mat1b interior_;
   int island_count_ = 0;
   UvWrap wrap_ = UvWrap::kRepeat;
 };

@@ -61,6 +61,7 @@ class TactileRenderer {
   std::optional<TextureOverlay> overlay_;
   TactileFrame frame_;
   cv::Mat1f h_final_;
+  cv::Rect overlay_box_;  // what the overlay wrote last frame
 };
 
 }  // namespace norm2tex

@@ -27,8 +27,10 @@ class TextureOverlay {
   double reachMm() const { return reach_mm_; }
   double betaMm() const { return beta_mm_; }
 
-  /// Writes H_final (mm) for every pixel; `h_local` (optional) receives H_local (0 where no
-  /// surface). `raster` must hold UVs.
+  /// Writes H_final (mm) and, if given, H_local for every pixel of `raster.covered_box`
+  /// (0 where no surface). Outside that box both must already be 0: buffers of the wrong size
+  /// are (re)allocated and zeroed here; reusing callers clear only what they last wrote, which
+  /// spares two full-image writes per frame. `raster` must hold UVs.
   void apply(const ContactRaster& raster, double thickness_mm, cv::Mat1f& h_final,
              cv::Mat1f* h_local = nullptr) const;
 

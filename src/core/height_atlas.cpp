@@ -15,32 +15,19 @@ HeightAtlas::HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, UvWrap wrap)
   UvIslands islands = findUvIslands(valid_);
   labels_ = std::move(islands.labels);
   island_count_ = static_cast<int>(islands.islands.size());
-}
-
-int HeightAtlas::wrapIndex(int index, int size) const {
-  if (wrap_ == UvWrap::kClamp) return index < 0 ? 0 : (index >= size ? size - 1 : index);
-  const int wrapped = index % size;
-  return wrapped < 0 ? wrapped + size : wrapped;
-}
-
-float HeightAtlas::sample(double u, double v, bool* valid) const {
-  if (valid != nullptr) *valid = false;
-  if (heights_.empty() || !std::isfinite(u) || !std::isfinite(v)) return 0.0f;
-  if (wrap_ == UvWrap::kRepeat) {
-    u -= std::floor(u);
-    v -= std::floor(v);
-  } else {
-    u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-    v = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+  interior_.create(labels_.size());
+  for (int r = 0; r < labels_.rows; ++r) {
+    const int* row = labels_.ptr<int>(r);
+    const int* next = labels_.ptr<int>((r + 1) % labels_.rows);
+    uchar* out = interior_.ptr<uchar>(r);
+    for (int c = 0; c < labels_.cols; ++c) {
+      const int c1 = (c + 1) % labels_.cols;
+      out[c] = row[c] != 0 && row[c1] == row[c] && next[c] == row[c] && next[c1] == row[c];
+    }
   }
-  // Continuous texel coordinates with texel centres at integers; row 0 is v = 1.
-  const double x = u * heights_.cols - 0.5;
-  const double y = (1.0 - v) * heights_.rows - 0.5;
-  const int x0 = static_cast<int>(std::floor(x));
-  const int y0 = static_cast<int>(std::floor(y));
-  const float fx = static_cast<float>(x - x0);
-  const float fy = static_cast<float>(y - y0);
+}
 
+float HeightAtlas::sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const {
   const int cols[2] = {wrapIndex(x0, heights_.cols), wrapIndex(x0 + 1, heights_.cols)};
   const int rows[2] = {wrapIndex(y0, heights_.rows), wrapIndex(y0 + 1, heights_.rows)};
   const float weights[2][2] = {{(1 - fx) * (1 - fy), fx * (1 - fy)}, {(1 - fx) * fy, fx * fy}};

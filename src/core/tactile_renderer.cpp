@@ -51,10 +51,18 @@ const TactileFrame& TactileRenderer::render(const Eigen::Isometry3d& object_in_g
                         frame_.raster);
   const cv::Mat1f* h_final = &frame_.raster.h_sensor_mm;
   if (textured) {
+    // The overlay writes only the covered box: clear what the previous frame wrote.
+    if (!overlay_box_.empty() && h_final_.size() == model_.imageSize()) {
+      h_final_(overlay_box_).setTo(0.0f);
+      frame_.h_local(overlay_box_).setTo(0.0f);
+    }
     overlay_->apply(frame_.raster, model_.gel_thickness_mm, h_final_, &frame_.h_local);
+    overlay_box_ = frame_.raster.covered_box;
     h_final = &h_final_;
   } else {
     frame_.h_local.release();
+    h_final_.release();
+    overlay_box_ = cv::Rect();
   }
   frame_.textured = textured;
   cv::compare(*h_final, 0.0f, frame_.contact_mask, cv::CMP_GT);

@@ -20,12 +20,11 @@ TextureOverlay::TextureOverlay(std::shared_ptr<const HeightAtlas> atlas, double 
 
 void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv::Mat1f& h_final,
                            cv::Mat1f* h_local) const {
-  h_final.create(raster.gap_mm.size());
-  h_final.setTo(0.0f);
-  if (h_local != nullptr) {
-    h_local->create(raster.gap_mm.size());
-    h_local->setTo(0.0f);
-  }
+  const auto prepare = [&raster](cv::Mat1f& buffer) {
+    if (buffer.size() != raster.gap_mm.size()) buffer = cv::Mat1f::zeros(raster.gap_mm.size());
+  };
+  prepare(h_final);
+  if (h_local != nullptr) prepare(*h_local);
   if (raster.covered_box.empty()) return;
   if (raster.uv.size() != raster.gap_mm.size()) throw Error("TextureOverlay: raster has no UVs");
   const float beta = static_cast<float>(beta_mm_);
@@ -37,7 +36,11 @@ void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv:
     float* out = h_final.ptr<float>(r);
     float* local = h_local != nullptr ? h_local->ptr<float>(r) : nullptr;
     for (int c = box.x; c < box.x + box.width; ++c) {
-      if (!std::isfinite(gap[c])) continue;
+      if (!std::isfinite(gap[c])) {
+        out[c] = 0.0f;
+        if (local != nullptr) local[c] = 0.0f;
+        continue;
+      }
       const float height = atlas_->sample(uv[c][0], uv[c][1]);
       out[c] = std::clamp(-gap[c] + beta * height, 0.0f, thickness);
       if (local != nullptr) local[c] = height;

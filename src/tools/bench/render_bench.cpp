@@ -1,5 +1,6 @@
 // Per-frame cost of the DIGIT renderer at 320 x 240 (one core): whole frames with and without
 // texture, a 200k-triangle mesh, and each stage on its own.
+#include <cmath>
 #include <memory>
 
 #include <benchmark/benchmark.h>
@@ -15,9 +16,13 @@
 
 namespace {
 
-// The reference scene: a 10 mm sphere pressed 1 mm at the gel centre.
-Eigen::Isometry3d pressedSphere() {
+// The reference scene: a 10 mm sphere pressed 1 mm near the gel centre. The UV
+// sphere lies on its side (contact on the equator, like a real textured ball); pressed on its
+// pole instead, the UVs fan around the whole atlas width (BM_Render_Textured_AtUvPole).
+Eigen::Isometry3d pressedSphere(bool at_pole = false) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  if (!at_pole)
+    pose.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
   pose.translation() = Eigen::Vector3d(0.0003, -0.0002, 0.005 - 0.001);
   return pose;
 }
@@ -40,10 +45,10 @@ std::shared_ptr<const norm2tex::HeightAtlas> atlas() {
 }
 
 void renderLoop(benchmark::State& state, std::shared_ptr<const norm2tex::TexturedMesh> mesh,
-                double beta_mm, std::int64_t seed) {
+                double beta_mm, std::int64_t seed, bool at_pole = false) {
   norm2tex::TactileRenderer renderer(norm2tex::makeDigitSensorModel());
   renderer.setObject(std::move(mesh), beta_mm > 0 ? atlas() : nullptr, beta_mm);
-  const Eigen::Isometry3d pose = pressedSphere();
+  const Eigen::Isometry3d pose = pressedSphere(at_pole);
   int frame = 0;
   for (auto _ : state) {
     const norm2tex::TactileFrame& out = renderer.render(pose, seed < 0 ? -1 : seed + frame++);
@@ -54,6 +59,9 @@ void renderLoop(benchmark::State& state, std::shared_ptr<const norm2tex::Texture
 
 void BM_Render_Textureless(benchmark::State& state) { renderLoop(state, sphere(96, 192), 0.0, 1); }
 void BM_Render_Textured(benchmark::State& state) { renderLoop(state, sphere(96, 192), 0.2, 1); }
+void BM_Render_Textured_AtUvPole(benchmark::State& state) {
+  renderLoop(state, sphere(96, 192), 0.2, 1, true);
+}
 void BM_Render_Textured_200kTriangles(benchmark::State& state) {
   renderLoop(state, sphere(317, 317), 0.2, 1);
 }
@@ -102,6 +110,7 @@ void BM_Stage_Shading(benchmark::State& state) {
 
 BENCHMARK(BM_Render_Textureless)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Render_Textured_AtUvPole)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_200kTriangles)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Stage_Raster)->ArgName("uv")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Overlay)->Unit(benchmark::kMicrosecond);
