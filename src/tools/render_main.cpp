@@ -1,15 +1,18 @@
 // norm2tex_render: one DIGIT frame of a mesh pressed into the gel, with or without texture.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_arguments.hpp"
+#include "contact_sheet.hpp"
 #include "norm2tex/atlas_cache.hpp"
 #include "norm2tex/error.hpp"
 #include "norm2tex/image_io.hpp"
@@ -24,6 +27,8 @@ constexpr const char* kUsage =
     "                       [--normal-map N.png | --atlas H.tiff] [--beta MM] [--scale S]\n"
     "                       [--sensor digit.yaml] [--background BG.png] [--seed S] [--no-noise]\n"
     "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
+    "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
+    "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png\n"
     "  --mesh: a mesh file (OBJ, STL, PLY, DAE, glTF/GLB) or a primitive: sphere:<radius_mm>,\n"
     "          box:<x_mm>x<y_mm>x<z_mm>\n"
     "  --pose: the object in the gel frame, metres and radians (roll, pitch, yaw about fixed\n"
@@ -35,7 +40,9 @@ constexpr const char* kUsage =
     "          Without either, the mesh's own normal texture (glTF/OBJ material) is used.\n"
     "  --beta: texture depth in mm (default 0.2 when a texture is given; 0 = textureless).\n"
     "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
-    "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n";
+    "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
+    "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
+    "          texture, then one row per normal map.\n";
 
 std::shared_ptr<const norm2tex::TexturedMesh> loadMesh(const std::string& spec, double scale) {
   if (spec.rfind("sphere:", 0) == 0) {
@@ -84,6 +91,24 @@ Eigen::Isometry3d parsePose(const std::string& text, double press_mm) {
   return pose;
 }
 
+std::shared_ptr<const norm2tex::HeightAtlas> bakeCached(const std::string& normal_map) {
+  const norm2tex::AtlasCache cache(norm2tex::AtlasCache::defaultDirectory());
+  norm2tex::AtlasCache::Result result = cache.loadOrBake(normal_map, "", {});
+  if (!result.store_error.empty()) {
+    std::fprintf(stderr, "norm2tex_render: warning: %s\n", result.store_error.c_str());
+  }
+  return std::make_shared<norm2tex::HeightAtlas>(std::move(result.atlas));
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::istringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
 std::shared_ptr<const norm2tex::HeightAtlas> loadAtlas(const norm2tex::cli::Arguments& args,
                                                        const norm2tex::TexturedMesh& mesh) {
   if (const auto atlas_path = args.value("--atlas")) {
@@ -95,22 +120,61 @@ std::shared_ptr<const norm2tex::HeightAtlas> loadAtlas(const norm2tex::cli::Argu
     }
     return std::make_shared<norm2tex::HeightAtlas>(heights, cv::Mat1b(heights.size(), 255));
   }
-  std::string normal_map = args.value("--normal-map", mesh.normalTexturePath());
-  if (normal_map.empty()) return nullptr;
-  const norm2tex::AtlasCache cache(norm2tex::AtlasCache::defaultDirectory());
-  norm2tex::AtlasCache::Result result = cache.loadOrBake(normal_map, "", {});
-  if (!result.store_error.empty()) {
-    std::fprintf(stderr, "norm2tex_render: warning: %s\n", result.store_error.c_str());
+  const std::string normal_map = args.value("--normal-map", mesh.normalTexturePath());
+  return normal_map.empty() ? nullptr : bakeCached(normal_map);
+}
+
+/// --sheet: rows = no texture, then each normal map; columns = press depths.
+int renderSheet(const norm2tex::cli::Arguments& args, const norm2tex::SensorModel& model,
+                std::shared_ptr<const norm2tex::TexturedMesh> mesh, const std::string& output) {
+  std::vector<double> presses;
+  for (const std::string& item : splitList(args.value("--presses", "0.5,1.0,1.5"))) {
+    std::istringstream text(item);
+    double press = 0;
+    if (!(text >> press))
+      throw norm2tex::cli::UsageError("--presses: not a number: '" + item + "'");
+    presses.push_back(press);
   }
-  return std::make_shared<norm2tex::HeightAtlas>(std::move(result.atlas));
+  const std::vector<std::string> maps = splitList(args.value("--normal-map", ""));
+  const double beta = args.number("--beta", 0.1);
+  const std::int64_t seed = args.flag("--no-noise") ? -1 : args.integer("--seed", 0);
+  const auto shortNumber = [](double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  };
+  norm2tex::TactileRenderer renderer(model);
+  std::vector<std::vector<cv::Mat3b>> tiles;
+  std::vector<std::string> row_labels{"no texture"}, column_labels;
+  for (const double press : presses) column_labels.push_back("press " + shortNumber(press) + " mm");
+  const auto addRow = [&](std::shared_ptr<const norm2tex::HeightAtlas> atlas) {
+    renderer.setObject(mesh, atlas, atlas ? beta : 0.0);
+    tiles.emplace_back();
+    for (const double press : presses) {
+      tiles.back().push_back(
+          renderer.render(parsePose(*args.value("--pose"), press), seed).image.clone());
+    }
+  };
+  addRow(nullptr);
+  for (const std::string& map : maps) {
+    addRow([&] {
+      const norm2tex::cli::QuietStderr quiet_decoders;
+      return bakeCached(map);
+    }());
+    row_labels.push_back(std::filesystem::path(map).stem().string() + ", beta " +
+                         shortNumber(beta) + " mm");
+  }
+  norm2tex::writeImage(output, norm2tex::cli::makeContactSheet(tiles, row_labels, column_labels));
+  std::printf("%s: %zu x %zu contact sheet\n", output.c_str(), tiles.size(), presses.size());
+  return 0;
 }
 
 int run(int argc, char** argv) {
   const norm2tex::cli::Arguments args(
       argc, argv,
       {"--mesh", "--pose", "--press-mm", "--normal-map", "--atlas", "--beta", "--scale", "--sensor",
-       "--background", "--seed", "-o", "--depth-out", "--mask-out"},
-      {"--no-noise", "-h", "--help"});
+       "--background", "--seed", "-o", "--depth-out", "--mask-out", "--presses"},
+      {"--no-noise", "--sheet", "-h", "--help"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
     return 0;
@@ -119,6 +183,9 @@ int run(int argc, char** argv) {
   if (!args.has("--pose")) throw norm2tex::cli::UsageError("missing --pose");
   const std::string output = args.value("-o", "");
   if (output.empty()) throw norm2tex::cli::UsageError("missing -o OUT.png");
+  if (!args.flag("--sheet") && args.value("--normal-map", "").find(',') != std::string::npos) {
+    throw norm2tex::cli::UsageError("several --normal-map files only with --sheet");
+  }
   if (args.has("--normal-map") && args.has("--atlas")) {
     throw norm2tex::cli::UsageError("give --normal-map or --atlas, not both");
   }
@@ -132,6 +199,7 @@ int run(int argc, char** argv) {
     const norm2tex::cli::QuietStderr quiet_decoders;
     return loadMesh(*args.value("--mesh"), args.number("--scale", 1.0));
   }();
+  if (args.flag("--sheet")) return renderSheet(args, model, mesh, output);
   const auto atlas = [&] {
     const norm2tex::cli::QuietStderr quiet_decoders;
     return loadAtlas(args, *mesh);
@@ -153,11 +221,10 @@ int run(int argc, char** argv) {
     norm2tex::writeImage(*depth_out, frame.depthMetres());
   if (const auto mask_out = args.value("--mask-out"))
     norm2tex::writeImage(*mask_out, frame.contact_mask);
-  std::printf(
-      "%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
-      cv::countNonZero(frame.contact_mask),
-      frame.textured ? ("textured, beta " + std::to_string(beta) + " mm").c_str() : "textureless",
-      frame.raster.triangles_rasterized, ms);
+  char texture[64] = "textureless";
+  if (frame.textured) std::snprintf(texture, sizeof(texture), "textured, beta %.3g mm", beta);
+  std::printf("%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
+              cv::countNonZero(frame.contact_mask), texture, frame.raster.triangles_rasterized, ms);
   return 0;
 }
 
