@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 namespace norm2tex {
@@ -66,6 +67,20 @@ int Arguments::integer(const std::string& name, int fallback) const {
     throw UsageError(name + " expects an integer, got '" + *value(name) + "'");
   }
   return static_cast<int>(parsed);
+}
+
+int runMain(const char* name, const char* usage, int (*run)(int, char**), int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "%s: %s\n%s", name, e.what(), usage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::string reason = e.what();  // one line, even when OpenCV's message has several
+    for (char& c : reason) c = (c == '\n' || c == '\r') ? ' ' : c;
+    std::fprintf(stderr, "%s: error: %s\n", name, reason.c_str());
+    return 1;
+  }
 }
 
 }  // namespace cli

@@ -38,5 +38,10 @@ class Arguments {
   std::set<std::string> flags_;
 };
 
+/// Runs a tool's `run` and turns what it throws into the tools' shared exit convention:
+/// UsageError -> "<name>: <reason>" plus the usage on stderr, exit 2; any other exception ->
+/// one line "<name>: error: <reason>", exit 1.
+int runMain(const char* name, const char* usage, int (*run)(int, char**), int argc, char** argv);
+
 }  // namespace cli
 }  // namespace norm2tex

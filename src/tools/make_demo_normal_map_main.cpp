@@ -65,13 +65,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const norm2tex::cli::UsageError& e) {
-    std::fprintf(stderr, "norm2tex_make_demo_normal_map: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "norm2tex_make_demo_normal_map: error: %s\n", e.what());
-    return 1;
-  }
+  return norm2tex::cli::runMain("norm2tex_make_demo_normal_map", kUsage, run, argc, argv);
 }

@@ -231,15 +231,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const norm2tex::cli::UsageError& e) {
-    std::fprintf(stderr, "norm2tex_render: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::string reason = e.what();
-    for (char& c : reason) c = (c == '\n' || c == '\r') ? ' ' : c;
-    std::fprintf(stderr, "norm2tex_render: error: %s\n", reason.c_str());
-    return 1;
-  }
+  return norm2tex::cli::runMain("norm2tex_render", kUsage, run, argc, argv);
 }

@@ -1,6 +1,4 @@
 // Runs the real norm2tex_bake executable: outputs, exit codes and one-line errors.
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -10,27 +8,17 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "cli_runner.hpp"
 #include "norm2tex/analytic_surface.hpp"
 #include "norm2tex/normal_encoding.hpp"
 
 namespace {
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
+using norm2tex::test::CliRun;
 
 CliRun bake(const std::string& arguments) {
-  const std::string command = std::string(NORM2TEX_BAKE_EXECUTABLE) + " " + arguments + " 2>&1";
-  CliRun run{-1, ""};
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  while (fgets(buffer, sizeof(buffer), pipe) != nullptr) run.output += buffer;
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return norm2tex::test::runCommand(NORM2TEX_BAKE_EXECUTABLE, arguments);
 }
 
 class BakeCli : public testing::Test {
