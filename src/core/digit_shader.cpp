@@ -14,15 +14,15 @@ namespace norm2tex {
 namespace {
 
 // Response: x = kShadingScale * (shading(H) - shading(flat)) per channel, in grey levels per
-// unit of n . l, then a soft knee x / (1 + |x| / kKneeGreyLevels) and shading_gain. The knee
-// stands for the camera and coating saturating on steep slopes: real DIGIT presses show colour
-// across the whole contact rather than a bright rim only. Linear Lambert shading gives a 95th
-// percentile / mean ratio of 2.6 inside a ball contact; real frames give 48 / 29 = 1.65. Both
-// constants were fitted so that a ball of 8.8 mm pressed 1.5 mm into the gel (after the
-// GelModel smoothing) gives a mean |frame - background| of 29 grey levels inside the contact
-// and a 95th percentile of 48, as measured on real DIGIT ball presses.
-constexpr float kShadingScale = 360.0f;
-constexpr float kKneeGreyLevels = 70.0f;
+// unit of n . l, then a soft knee x / (1 + |x| / kKneeGreyLevels) and shading_gain. Fitted so
+// that a ball of 8.8 mm pressed 1.5 mm into the gel, through the GelModel, differs from the
+// background inside the contact by 32 grey levels on average with a 95th percentile of 44 and
+// a peak of 94; real DIGIT ball presses measure about 29 and 48. Our contact shading is more
+// uniform than a real one (48 / 29 = 1.65 there, 1.4 here), so mean and tail cannot both
+// match; a strong knee (70) matched the mean (30) but cut the tail to 36. The knee keeps steep
+// rims from burning out: the brightest background channel (~135) plus 100 stays below 255.
+constexpr float kShadingScale = 205.0f;
+constexpr float kKneeGreyLevels = 300.0f;
 
 // Light falls off as (d_centre / d)^kFalloffExponent, normalised to 1 at the gel centre. TACTO
 // uses 1/d^2, but with the LEDs ~9 mm from the nearest image corner that makes a press near an

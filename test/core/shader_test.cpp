@@ -230,8 +230,9 @@ TEST_F(ShaderTest, BallPressHasRealisticMagnitudes) {
   cv::circle(far, cv::Point(model.cols / 2, model.rows / 2), cvRound(1.5 * contact_radius_px), 0,
              cv::FILLED);
   EXPECT_LT(meanAbs(diff, far), 0.5);
-  // Bounded: the response saturates instead of burning out at the rim.
-  EXPECT_LT(cv::norm(shader.shadingDifference(h), cv::NORM_INF), 80.0);
+  // Bounded: the response saturates instead of burning out at the rim (the brightest
+  // background channel, ~135, plus 100 stays below 255).
+  EXPECT_LT(cv::norm(shader.shadingDifference(h), cv::NORM_INF), 100.0);
 }
 
 TEST_F(ShaderTest, SlopesAreScaleInvariantAcrossResolutions) {
