@@ -31,7 +31,7 @@ Arguments::Arguments(int argc, char** argv, const std::set<std::string>& value_o
         if (i + 1 >= argc) throw UsageError(name + " needs a value");
         inline_value = argv[++i];
       }
-      values_[name] = inline_value;
+      values_[name].push_back(inline_value);
     } else {
       throw UsageError("unknown option " + name);
     }
@@ -43,7 +43,12 @@ bool Arguments::has(const std::string& name) const { return values_.count(name) 
 std::optional<std::string> Arguments::value(const std::string& name) const {
   const auto it = values_.find(name);
   if (it == values_.end()) return std::nullopt;
-  return it->second;
+  return it->second.back();
+}
+
+std::vector<std::string> Arguments::values(const std::string& name) const {
+  const auto it = values_.find(name);
+  return it == values_.end() ? std::vector<std::string>() : it->second;
 }
 
 std::string Arguments::value(const std::string& name, const std::string& fallback) const {

@@ -26,7 +26,10 @@ class Arguments {
   const std::vector<std::string>& positional() const { return positional_; }
   bool has(const std::string& name) const;
   bool flag(const std::string& name) const { return flags_.count(name) > 0; }
+  /// The last value given for `name` (options may repeat; see values()).
   std::optional<std::string> value(const std::string& name) const;
+  /// Every value given for `name`, in order (empty if none).
+  std::vector<std::string> values(const std::string& name) const;
   std::string value(const std::string& name, const std::string& fallback) const;
   /// The option as a finite number, or `fallback` if absent; UsageError if not a number.
   double number(const std::string& name, double fallback) const;
@@ -34,7 +37,7 @@ class Arguments {
 
  private:
   std::vector<std::string> positional_;
-  std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> values_;
   std::set<std::string> flags_;
 };
 

@@ -16,8 +16,10 @@
 #include "norm2tex/atlas_cache.hpp"
 #include "norm2tex/error.hpp"
 #include "norm2tex/image_io.hpp"
+#include "norm2tex/material_texture.hpp"
 #include "norm2tex/mesh_primitives.hpp"
 #include "norm2tex/tactile_renderer.hpp"
+#include "package_paths.hpp"
 #include "quiet_stderr.hpp"
 
 namespace {
@@ -25,7 +27,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: norm2tex_render --mesh M --pose \"x y z roll pitch yaw\" [--press-mm D]\n"
     "                       [--normal-map N.png | --atlas H.tiff] [--beta MM] [--scale S]\n"
-    "                       [--sensor digit.yaml] [--background BG.png] [--seed S] [--no-noise]\n"
+    "                       [--material NAME] [--sensor digit.yaml] [--background BG.png]\n"
+    "                       [--seed S] [--no-noise]\n"
     "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
     "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
     "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png\n"
@@ -38,7 +41,11 @@ constexpr const char* kUsage =
     "  --press-mm D: then move the object D mm along -z, into the gel.\n"
     "  --normal-map: baked to H_global (cached on disk); --atlas: an H_global float TIFF.\n"
     "          Without either, the mesh's own normal texture (glTF/OBJ material) is used.\n"
-    "  --beta: texture depth in mm (default 0.2 when a texture is given; 0 = textureless).\n"
+    "  --material NAME: a procedural material (wood, fabric, rock, smooth, print3d) generated\n"
+    "          for the mesh's UVs at its true millimetre scale (a mesh without UVs is unwrapped\n"
+    "          first), with config/materials/NAME.yaml's parameters, range and beta.\n"
+    "  --beta: texture depth in mm (default: the material's, else 0.2 when a texture is given;\n"
+    "          0 = textureless).\n"
     "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
     "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
     "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
@@ -173,7 +180,7 @@ int run(int argc, char** argv) {
   const norm2tex::cli::Arguments args(
       argc, argv,
       {"--mesh", "--pose", "--press-mm", "--normal-map", "--atlas", "--beta", "--scale", "--sensor",
-       "--background", "--seed", "-o", "--depth-out", "--mask-out", "--presses"},
+       "--background", "--seed", "-o", "--depth-out", "--mask-out", "--presses", "--material"},
       {"--no-noise", "--sheet", "-h", "--help"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
@@ -186,6 +193,9 @@ int run(int argc, char** argv) {
   if (!args.flag("--sheet") && args.value("--normal-map", "").find(',') != std::string::npos) {
     throw norm2tex::cli::UsageError("several --normal-map files only with --sheet");
   }
+  if (args.has("--material") + args.has("--normal-map") + args.has("--atlas") > 1) {
+    throw norm2tex::cli::UsageError("give one of --material, --normal-map and --atlas");
+  }
   if (args.has("--normal-map") && args.has("--atlas")) {
     throw norm2tex::cli::UsageError("give --normal-map or --atlas, not both");
   }
@@ -195,16 +205,31 @@ int run(int argc, char** argv) {
                                     : norm2tex::makeDigitSensorModel();
   if (const auto background = args.value("--background")) model.background_image = *background;
   const auto pose = parsePose(*args.value("--pose"), args.number("--press-mm", 0.0));
-  const auto mesh = [&] {
+  std::shared_ptr<const norm2tex::TexturedMesh> mesh = [&] {
     const norm2tex::cli::QuietStderr quiet_decoders;
     return loadMesh(*args.value("--mesh"), args.number("--scale", 1.0));
   }();
   if (args.flag("--sheet")) return renderSheet(args, model, mesh, output);
-  const auto atlas = [&] {
+  std::shared_ptr<const norm2tex::HeightAtlas> atlas;
+  double default_beta = 0.2;
+  if (const auto material = args.value("--material")) {
+    // The material is generated for this mesh's own UV layout, so its scale in mm is right.
+    const norm2tex::MaterialConfig config =
+        norm2tex::loadMaterialConfig(norm2tex::cli::materialConfigPath(*material));
+    norm2tex::TexturedMesh textured = *mesh;
+    if (args.value("--mesh")->rfind("sphere:", 0) == 0) {
+      // The UV sphere's equirectangular UVs stretch 2:1; an unwrapped copy keeps mm true.
+      textured = norm2tex::TexturedMesh(mesh->vertices(), mesh->triangles());
+    }
+    atlas = std::make_shared<norm2tex::HeightAtlas>(norm2tex::bakeMaterialAtlas(
+        config, static_cast<std::uint64_t>(args.integer("--seed", 0)), textured));
+    mesh = std::make_shared<const norm2tex::TexturedMesh>(std::move(textured));
+    default_beta = config.beta_mm;
+  } else {
     const norm2tex::cli::QuietStderr quiet_decoders;
-    return loadAtlas(args, *mesh);
-  }();
-  const double beta = args.number("--beta", atlas ? 0.2 : 0.0);
+    atlas = loadAtlas(args, *mesh);
+  }
+  const double beta = args.number("--beta", atlas ? default_beta : 0.0);
 
   norm2tex::TactileRenderer renderer(model);
   const std::string warning = renderer.setObject(mesh, atlas, beta);

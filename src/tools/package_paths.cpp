@@ -1,0 +1,27 @@
+#include "package_paths.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "norm2tex/error.hpp"
+#include "norm2tex/procedural_material.hpp"
+
+namespace norm2tex {
+namespace cli {
+
+std::string configDirectory() {
+  if (const char* dir = std::getenv("NORM2TEX_CONFIG_DIR"); dir && *dir) return dir;
+  for (const char* candidate : {NORM2TEX_SOURCE_CONFIG_DIR, NORM2TEX_INSTALL_CONFIG_DIR}) {
+    if (std::filesystem::is_directory(candidate)) return candidate;
+  }
+  throw Error("cannot find norm2tex's config directory; set NORM2TEX_CONFIG_DIR");
+}
+
+std::string materialConfigPath(const std::string& name) {
+  const std::string path = configDirectory() + "/materials/" + name + ".yaml";
+  if (!std::filesystem::exists(path)) makeMaterial(name);  // unknown: the registry lists names
+  return path;
+}
+
+}  // namespace cli
+}  // namespace norm2tex

@@ -1,0 +1,123 @@
+// Materials on meshes: the relief keeps its millimetre scale on every UV island, padding.
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/material_texture.hpp"
+#include "norm2tex/mesh_primitives.hpp"
+#include "norm2tex/normal_map.hpp"
+
+namespace norm2tex {
+namespace {
+
+/// Two 10 mm squares side by side in space; A maps to UV [0, 0.25]^2, B to [0.5, 1]^2, so B
+/// gets twice A's texels per millimetre.
+TexturedMesh twoQuadsOfDifferentUvScale() {
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Eigen::Vector2f> uvs;
+  std::vector<Eigen::Vector3i> triangles;
+  const auto addQuad = [&](float x0, float u0, float u1) {
+    const int base = static_cast<int>(vertices.size());
+    for (int corner = 0; corner < 4; ++corner) {
+      const float sx = (corner == 1 || corner == 2) ? 1.0f : 0.0f, sy = corner >= 2 ? 1.0f : 0.0f;
+      vertices.emplace_back(x0 + 0.01f * sx, 0.01f * sy, 0.0f);
+      uvs.emplace_back(u0 + (u1 - u0) * sx, u0 + (u1 - u0) * sy);
+    }
+    triangles.emplace_back(base, base + 1, base + 2);
+    triangles.emplace_back(base, base + 2, base + 3);
+  };
+  addQuad(0.0f, 0.0f, 0.25f);
+  addQuad(0.02f, 0.5f, 1.0f);
+  return TexturedMesh(vertices, triangles, uvs);
+}
+
+/// Dominant period (texels) of the row-averaged profile of `height` inside `mask`, by FFT.
+double dominantRowPeriod(const cv::Mat1f& height, const cv::Mat1b& mask) {
+  const cv::Rect box = cv::boundingRect(mask);
+  cv::Mat1f profile;
+  cv::reduce(height(box), profile, 1, cv::REDUCE_AVG);  // one value per row
+  profile -= cv::mean(profile)[0];
+  const int n = cv::getOptimalDFTSize(profile.rows * 8);  // zero-pad for a finer peak
+  cv::Mat1f padded = cv::Mat1f::zeros(n, 1);
+  profile.copyTo(padded(cv::Rect(0, 0, 1, profile.rows)));
+  cv::Mat spectrum;
+  cv::dft(padded, spectrum, cv::DFT_COMPLEX_OUTPUT);
+  int best = 1;
+  double best_power = 0;
+  for (int k = 1; k < n / 2; ++k) {
+    const cv::Vec2f z = spectrum.at<cv::Vec2f>(k);
+    const double power = z[0] * z[0] + z[1] * z[1];
+    if (power > best_power) {
+      best_power = power;
+      best = k;
+    }
+  }
+  return static_cast<double>(n) / best;
+}
+
+TEST(MaterialTexture, PeriodInMillimetresIsTheSameOnFacesOfDifferentUvScale) {
+  auto material = makeMaterial("print3d");
+  material->setParameter("layer_pitch_mm", 0.5);
+  material->setParameter("layer_angle_deg", 0.0);  // lines along x: the period runs along rows
+  material->setParameter("layer_variation", 0.0);
+  material->setParameter("infill_amplitude_mm", 0.0);
+  const UvLayout layout = computeUvLayout(twoQuadsOfDifferentUvScale(), cv::Size(512, 512));
+  ASSERT_EQ(layout.metres_per_uv.size(), 3u);
+  const MaterialTexture texture = renderMaterialTexture(*material, layout, CV_16U, 4);
+  double texels_per_period[3] = {0, 0, 0};
+  for (int island = 1; island <= 2; ++island) {
+    const cv::Mat1b mask = layout.island == island;
+    const double mm_per_texel = layout.metres_per_uv[island] * 1e3 / 512;
+    texels_per_period[island] = dominantRowPeriod(texture.height_mm, mask);
+    EXPECT_NEAR(texels_per_period[island] * mm_per_texel, 0.5, 0.02) << "island " << island;
+    EXPECT_FLOAT_EQ(cv::mean(texture.mm_per_texel, mask)[0], mm_per_texel);
+  }
+  // B has twice the texels per mm, so the same 0.5 mm takes twice the texels.
+  EXPECT_NEAR(texels_per_period[2] / texels_per_period[1], 2.0, 0.1);
+}
+
+TEST(MaterialTexture, NormalMapAlphaIsTheIslandsAndPaddingCarriesTheirNormals) {
+  const auto material = makeMaterial("rock");
+  const UvLayout layout = computeUvLayout(twoQuadsOfDifferentUvScale(), cv::Size(256, 256));
+  const MaterialTexture texture = renderMaterialTexture(*material, layout, CV_8U, 3);
+  ASSERT_EQ(texture.normal_map.type(), CV_8UC4);
+  std::vector<cv::Mat> channels;
+  cv::split(texture.normal_map, channels);
+  EXPECT_EQ(cv::countNonZero(channels[3] != texture.valid), 0) << "alpha = islands";
+  // A texel just outside island A's right edge holds A's border normal, not the flat colour.
+  const cv::Rect a = cv::boundingRect(layout.island == 1);
+  const int r = a.y + a.height / 2, c = a.x + a.width;  // first texel right of the island
+  ASSERT_EQ(layout.island(r, c), 0);
+  const cv::Vec4b border = texture.normal_map.at<cv::Vec4b>(r, c - 1);
+  const cv::Vec4b padded = texture.normal_map.at<cv::Vec4b>(r, c);
+  EXPECT_EQ(cv::Vec3b(padded[0], padded[1], padded[2]), cv::Vec3b(border[0], border[1], border[2]));
+  EXPECT_EQ(padded[3], 0);
+  // Decoded with its alpha, the map has exactly the two islands' texels valid.
+  const NormalMap decoded = NormalMap::fromImage(texture.normal_map);
+  EXPECT_EQ(decoded.validCount(), cv::countNonZero(texture.valid));
+}
+
+TEST(MaterialTexture, PlainTextureIsAllValidAtTheGivenResolution) {
+  const auto material = makeMaterial("fabric");
+  const MaterialTexture texture = renderMaterialTexture(*material, 128, 0.05, CV_16U);
+  EXPECT_EQ(texture.normal_map.type(), CV_16UC4);
+  EXPECT_EQ(cv::countNonZero(texture.valid), 128 * 128);
+  EXPECT_EQ(cv::norm(texture.height_mm, material->renderHeightMm({128, 128}, 0.05), cv::NORM_INF),
+            0.0);
+}
+
+TEST(MaterialTexture, BakedMaterialAtlasFitsAMeshWithoutUvs) {
+  const TexturedMesh with_uvs = makeBox(Eigen::Vector3d(0.02, 0.02, 0.01));
+  TexturedMesh mesh(with_uvs.vertices(), with_uvs.triangles());
+  MaterialConfig config;
+  config.name = "rock";
+  config.size = 256;
+  const HeightAtlas atlas = bakeMaterialAtlas(config, 7, mesh);
+  EXPECT_TRUE(mesh.hasUvs()) << "unwrapped in place";
+  EXPECT_EQ(atlas.rows(), 256);
+  EXPECT_GE(atlas.islandCount(), 6) << "one island per box face at least";
+}
+
+}  // namespace
+}  // namespace norm2tex
