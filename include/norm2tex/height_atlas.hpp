@@ -30,28 +30,35 @@ class HeightAtlas {
   HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, UvWrap wrap = UvWrap::kRepeat);
 
   /// H_global at (u, v); `valid` (optional) tells whether any texel of an island was found.
-  /// Inline: the renderer calls it for every contact pixel of every frame.
   float sample(double u, double v, bool* valid = nullptr) const {
-    if (valid != nullptr) *valid = false;
-    if (heights_.empty() || !std::isfinite(u) || !std::isfinite(v)) return 0.0f;
+    if (heights_.empty() || !std::isfinite(u) || !std::isfinite(v)) {
+      if (valid != nullptr) *valid = false;
+      return 0.0f;
+    }
+    return sampleFinite(static_cast<float>(u), static_cast<float>(v), valid);
+  }
+
+  /// sample() for a non-empty atlas and finite u, v, in float: the renderer's per-pixel
+  /// look-up (mesh UVs are checked to be finite when the mesh is built). Inline on purpose.
+  float sampleFinite(float u, float v, bool* valid = nullptr) const {
     if (wrap_ == UvWrap::kRepeat) {
-      u -= floorToInt(u);
-      v -= floorToInt(v);
+      u -= static_cast<float>(floorToInt(u));
+      v -= static_cast<float>(floorToInt(v));
     } else {
-      u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
-      v = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+      u = u < 0.0f ? 0.0f : (u > 1.0f ? 1.0f : u);
+      v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);
     }
     // Continuous texel coordinates with texel centres at integers; row 0 is v = 1.
-    const double x = u * heights_.cols - 0.5;
-    const double y = (1.0 - v) * heights_.rows - 0.5;
+    const float x = u * heights_.cols - 0.5f;
+    const float y = (1.0f - v) * heights_.rows - 0.5f;
     const int x0 = floorToInt(x), y0 = floorToInt(y);
-    const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+    const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
     // Fast path: the four texels are neighbours inside one island, away from the map's edge.
     if (x0 >= 0 && y0 >= 0 && x0 + 1 < heights_.cols && y0 + 1 < heights_.rows &&
         interior_(y0, x0)) {
       if (valid != nullptr) *valid = true;
       const float* top = heights_.ptr<float>(y0) + x0;
-      const float* bottom = heights_.ptr<float>(y0 + 1) + x0;
+      const float* bottom = top + heights_.step1();
       return (1 - fy) * ((1 - fx) * top[0] + fx * top[1]) +
              fy * ((1 - fx) * bottom[0] + fx * bottom[1]);
     }
@@ -77,9 +84,9 @@ class HeightAtlas {
     return index;
   }
   /// floor() without a libm call (baseline x86-64 has no rounding instruction); |x| < 2^31.
-  static int floorToInt(double x) {
+  static int floorToInt(float x) {
     const int truncated = static_cast<int>(x);
-    return truncated - (x < truncated ? 1 : 0);
+    return truncated - (x < static_cast<float>(truncated) ? 1 : 0);
   }
   /// Bilinear look-up near an island's border or the map's edge (x0, y0 in [-1, size - 1]).
   float sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const;

@@ -28,6 +28,7 @@ HeightAtlas::HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, UvWrap wrap)
 }
 
 float HeightAtlas::sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const {
+  if (valid != nullptr) *valid = false;
   const int cols[2] = {wrapIndex(x0, heights_.cols), wrapIndex(x0 + 1, heights_.cols)};
   const int rows[2] = {wrapIndex(y0, heights_.rows), wrapIndex(y0 + 1, heights_.rows)};
   const float weights[2][2] = {{(1 - fx) * (1 - fy), fx * (1 - fy)}, {(1 - fx) * fy, fx * fy}};

@@ -41,7 +41,7 @@ void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv:
         if (local != nullptr) local[c] = 0.0f;
         continue;
       }
-      const float height = atlas_->sample(uv[c][0], uv[c][1]);
+      const float height = atlas_->sampleFinite(uv[c][0], uv[c][1]);
       out[c] = std::clamp(-gap[c] + beta * height, 0.0f, thickness);
       if (local != nullptr) local[c] = height;
     }
