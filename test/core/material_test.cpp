@@ -26,24 +26,12 @@
 namespace norm2tex {
 namespace {
 
+using test::expectError;
+
 constexpr double kPi = 3.14159265358979323846;
 
 std::string configPath(const std::string& name) {
   return std::string(NORM2TEX_SOURCE_DIR "/config/materials/") + name + ".yaml";
-}
-
-/// Expects `code` to throw Error whose message contains every one of `parts`.
-template <typename F>
-void expectError(F code, const std::vector<std::string>& parts) {
-  try {
-    code();
-    ADD_FAILURE() << "no Error thrown; expected one mentioning " << parts.front();
-  } catch (const Error& e) {
-    for (const std::string& part : parts) {
-      EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
-          << "message '" << e.what() << "' lacks '" << part << "'";
-    }
-  }
 }
 
 /// Texel size at which each material's features span several texels (the bake smooths normals

@@ -21,30 +21,14 @@
 namespace norm2tex {
 namespace {
 
+using test::expectError;
+
 namespace fs = std::filesystem;
 
 void writeFile(const std::string& path, const std::string& content) {
   std::ofstream file(path, std::ios::binary);
   file << content;
   ASSERT_TRUE(file.good()) << path;
-}
-
-// Runs `f`, expects an Error whose message contains every one of `needles`.
-template <typename F>
-void expectError(F f, const std::vector<std::string>& needles) {
-  try {
-    f();
-    ADD_FAILURE() << "no Error thrown; expected one mentioning " << needles.front();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& needle : needles) {
-      EXPECT_NE(message.find(needle), std::string::npos)
-          << "message '" << message << "' lacks '" << needle << "'";
-    }
-    EXPECT_EQ(message.find('\n'), std::string::npos) << "multi-line message: " << message;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw a non-Error exception: " << e.what();
-  }
 }
 
 void expectBounds(const TexturedMesh& mesh, const Eigen::Vector3f& min, const Eigen::Vector3f& max,

@@ -1,11 +1,16 @@
 #pragma once
 // Shared helpers of the core tests: statistics against analytic truth and scratch directories.
 
+#include <exception>
 #include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
 
 #include "norm2tex/analytic_surface.hpp"
+#include "norm2tex/error.hpp"
 #include "norm2tex/normal_map.hpp"
 
 namespace norm2tex {
@@ -25,6 +30,25 @@ double maskedStdDev(const cv::Mat1f& a, const cv::Mat1b& mask);
 /// again, the way a normal map file would arrive.
 NormalMap quantisedNormalMap(const AnalyticSurface& surface, const cv::Mat1b& mask, int depth,
                              NormalConvention convention = NormalConvention::kOpenGL);
+
+/// Expects `code` to throw norm2tex::Error with a one-line message containing every one of
+/// `parts` (a file name, a parameter, the valid choices...).
+template <typename F>
+void expectError(F code, const std::vector<std::string>& parts) {
+  try {
+    code();
+    ADD_FAILURE() << "no Error thrown; expected one mentioning " << parts.front();
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << "message '" << message << "' lacks '" << part << "'";
+    }
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "multi-line message: " << message;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "threw a non-Error exception: " << e.what();
+  }
+}
 
 /// A fresh directory under the system temp dir, removed with its content on destruction.
 class ScratchDirectory {

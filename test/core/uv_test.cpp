@@ -23,6 +23,8 @@
 namespace norm2tex {
 namespace {
 
+using test::expectError;
+
 namespace fs = std::filesystem;
 
 constexpr double kPi = 3.14159265358979323846;
@@ -32,23 +34,6 @@ constexpr double kPi = 3.14159265358979323846;
 // the 26 directions: ratio <= 1.13 (measured max: 1.117 on this sphere, 1.123 on the torus).
 // Smoothing (<= 40 deg) and merged fragments (<= 60 deg) only happen on noisy or jagged meshes.
 const double kCleanCurvedBound = 1.0 / std::cos(27.6 * kPi / 180.0) + 0.005;
-
-// Runs `f`, expects an Error whose message contains every one of `needles`.
-template <typename F>
-void expectError(F f, const std::vector<std::string>& needles) {
-  try {
-    f();
-    ADD_FAILURE() << "no Error thrown; expected one mentioning " << needles.front();
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    for (const std::string& needle : needles) {
-      EXPECT_NE(message.find(needle), std::string::npos)
-          << "message '" << message << "' lacks '" << needle << "'";
-    }
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "threw a non-Error exception: " << e.what();
-  }
-}
 
 TexturedMesh withoutUvs(const TexturedMesh& mesh) {
   return TexturedMesh(mesh.vertices(), mesh.triangles());
