@@ -22,7 +22,8 @@ namespace norm2tex {
 cv::Mat3b makeSyntheticBackground(cv::Size size);
 
 /// The user's own no-contact frame, resized to the model's image size if needed. Accepts 8- or
-/// 16-bit, gray, BGR or BGRA; throws Error naming the file if it cannot be used.
+/// 16-bit, gray, BGR or BGRA; throws Error naming the file if it cannot be used, including a
+/// landscape frame for a portrait sensor (or the reverse): a frame the driver did not rotate.
 cv::Mat3b loadBackground(const std::string& path, cv::Size size);
 
 /// Turns the gel's final indentation into a DIGIT image.

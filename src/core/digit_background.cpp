@@ -109,6 +109,17 @@ cv::Mat3b loadBackground(const std::string& path, cv::Size size) {
       throw Error("background image '" + path + "' has " + std::to_string(image.channels()) +
                   " channels; valid: 1 (gray), 3 (BGR) or 4 (BGRA)");
   }
+  // Resizing between presets is fine (a VGA frame for a QVGA model), but a landscape frame for
+  // a portrait sensor is a frame the driver did not transpose: stretching it would put the LED
+  // glows in the wrong places without anyone noticing.
+  const bool image_portrait = image.rows > image.cols, model_portrait = size.height > size.width;
+  if (image.rows != image.cols && size.height != size.width && image_portrait != model_portrait) {
+    throw Error("background image '" + path + "' is " + std::to_string(image.cols) + " x " +
+                std::to_string(image.rows) + " (" + (image_portrait ? "portrait" : "landscape") +
+                ") but the sensor image is " + std::to_string(size.width) + " x " +
+                std::to_string(size.height) + " (" + (model_portrait ? "portrait" : "landscape") +
+                "); rotate it the way your driver publishes frames");
+  }
   if (image.size() != size) cv::resize(image, image, size, 0.0, 0.0, cv::INTER_AREA);
   return image;
 }

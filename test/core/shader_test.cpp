@@ -417,6 +417,12 @@ TEST(BackgroundTest, BadFilesThrowErrorsNamingTheFile) {
 
   EXPECT_TRUE(messageContains([&] { loadBackground(dir.root(), size); }, dir.root()));
   EXPECT_THROW(loadBackground(text, cv::Size(0, 0)), Error);
+
+  // A frame the driver did not rotate (landscape for a portrait sensor) is refused, not
+  // silently stretched.
+  const std::string landscape = dir.path("landscape.png");
+  ASSERT_TRUE(cv::imwrite(landscape, makeSyntheticBackground({320, 240})));
+  test::expectError([&] { loadBackground(landscape, size); }, {landscape, "landscape", "rotate"});
 }
 
 }  // namespace
