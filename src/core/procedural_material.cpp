@@ -62,30 +62,37 @@ void ProceduralMaterial::checkGrid(cv::Size size, double mm_per_texel) {
   }
 }
 
+namespace {
+
+/// Fills an image with `at(row, column)` (the material's texel-centre convention lives in the
+/// callers, through texelX / texelY).
+template <typename Pixel, typename Function>
+cv::Mat_<Pixel> renderGrid(cv::Size size, Function at) {
+  cv::Mat_<Pixel> image(size);
+  for (int r = 0; r < size.height; ++r) {
+    Pixel* row = image.template ptr<Pixel>(r);
+    for (int c = 0; c < size.width; ++c) row[c] = at(r, c);
+  }
+  return image;
+}
+
+}  // namespace
+
 cv::Mat1f ProceduralMaterial::renderHeightMm(cv::Size size, double mm_per_texel,
                                              cv::Point2d origin_mm) const {
   checkGrid(size, mm_per_texel);
-  cv::Mat1f height(size);
-  for (int r = 0; r < size.height; ++r) {
-    const double y = texelY(r, mm_per_texel, origin_mm);
-    float* row = height.ptr<float>(r);
-    for (int c = 0; c < size.width; ++c) {
-      row[c] = static_cast<float>(heightMm(texelX(c, mm_per_texel, origin_mm), y));
-    }
-  }
-  return height;
+  return renderGrid<float>(size, [&](int r, int c) {
+    return static_cast<float>(
+        heightMm(texelX(c, mm_per_texel, origin_mm), texelY(r, mm_per_texel, origin_mm)));
+  });
 }
 
 cv::Mat3b ProceduralMaterial::renderAlbedo(cv::Size size, double mm_per_texel,
                                            cv::Point2d origin_mm) const {
   checkGrid(size, mm_per_texel);
-  cv::Mat3b albedo_image(size);
-  for (int r = 0; r < size.height; ++r) {
-    const double y = texelY(r, mm_per_texel, origin_mm);
-    cv::Vec3b* row = albedo_image.ptr<cv::Vec3b>(r);
-    for (int c = 0; c < size.width; ++c) row[c] = albedo(texelX(c, mm_per_texel, origin_mm), y);
-  }
-  return albedo_image;
+  return renderGrid<cv::Vec3b>(size, [&](int r, int c) {
+    return albedo(texelX(c, mm_per_texel, origin_mm), texelY(r, mm_per_texel, origin_mm));
+  });
 }
 
 std::vector<std::string> materialNames() { return {"wood", "fabric", "rock", "smooth", "print3d"}; }

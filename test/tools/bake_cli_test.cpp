@@ -21,11 +21,10 @@ CliRun bake(const std::string& arguments) {
   return norm2tex::test::runCommand(NORM2TEX_BAKE_EXECUTABLE, arguments);
 }
 
-class BakeCli : public testing::Test {
+class BakeCli : public norm2tex::test::CliTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("norm2tex_bake_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
+    CliTest::SetUp();
     const cv::Size size(96, 64);
     norm2tex::AnalyticSurface s = norm2tex::makeWaves(size, {{2.0, 30.0, 0.5, 0.0}});
     const cv::Mat1b mask = norm2tex::makeIslandMask(size, 2, 4);
@@ -34,9 +33,6 @@ class BakeCli : public testing::Test {
         norm2tex::encodeNormalMap(s.dx, s.dy, norm2tex::NormalConvention::kOpenGL, CV_16U, mask));
     cv::imwrite(path("mask.png"), mask);
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
 };
 
 TEST_F(BakeCli, WritesAFloatTiffOfTheMapsSize) {

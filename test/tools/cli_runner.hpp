@@ -2,9 +2,13 @@
 // Runs a command-line tool in a shell and captures its exit code and combined output.
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
+
+#include <gtest/gtest.h>
 
 namespace norm2tex {
 namespace test {
@@ -25,6 +29,20 @@ inline CliRun runCommand(const std::string& executable, const std::string& argum
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
 }
+
+/// Base fixture of the CLI tests: a fresh scratch directory per test, removed afterwards.
+class CliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           ("norm2tex_" + std::string(info->test_suite_name()) + "_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::filesystem::path dir_;
+};
 
 }  // namespace test
 }  // namespace norm2tex

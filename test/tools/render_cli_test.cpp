@@ -19,11 +19,10 @@ CliRun render(const std::string& arguments) {
   return norm2tex::test::runCommand(NORM2TEX_RENDER_EXECUTABLE, arguments);
 }
 
-class RenderCli : public testing::Test {
+class RenderCli : public norm2tex::test::CliTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("norm2tex_render_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
+    CliTest::SetUp();
     const cv::Size size(128, 128);
     const norm2tex::AnalyticSurface s = norm2tex::makeRidges(size, {0.5, 9.0, 1.5, 1.0});
     cv::imwrite(path("ridges.png"),
@@ -31,9 +30,6 @@ class RenderCli : public testing::Test {
     // Keep the bake cache inside the scratch directory.
     setenv("NORM2TEX_CACHE_DIR", path("cache").c_str(), 1);
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
 };
 
 constexpr const char* kBall = "--mesh sphere:5 --pose \"0.002 0 0.005 1.5708 0 0\" --press-mm 1";

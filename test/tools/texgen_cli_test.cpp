@@ -27,16 +27,7 @@ std::string readBytes(const std::string& path) {
   return bytes.str();
 }
 
-class TexgenCli : public testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("norm2tex_texgen_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
-};
+using TexgenCli = norm2tex::test::CliTest;
 
 TEST_F(TexgenCli, ListsEveryMaterialWithItsParameters) {
   const CliRun run = texgen("--list");
