@@ -7,9 +7,9 @@
 #include <opencv2/core.hpp>
 
 #include "cli_arguments.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/height_atlas_baker.hpp"
-#include "norm2tex/image_io.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/common/image_io.hpp"
 #include "quiet_stderr.hpp"
 
 namespace {

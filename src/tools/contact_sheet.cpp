@@ -2,7 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/error.hpp"
+#include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
 namespace cli {

@@ -8,10 +8,10 @@
 #include <opencv2/core.hpp>
 
 #include "cli_arguments.hpp"
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/image_io.hpp"
-#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/common/image_io.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
 
 namespace {
 

@@ -3,8 +3,8 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/procedural_material.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/materials/procedural_material.hpp"
 
 namespace norm2tex {
 namespace cli {

@@ -13,12 +13,12 @@
 
 #include "cli_arguments.hpp"
 #include "contact_sheet.hpp"
-#include "norm2tex/atlas_cache.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/image_io.hpp"
-#include "norm2tex/material_texture.hpp"
-#include "norm2tex/mesh_primitives.hpp"
-#include "norm2tex/tactile_renderer.hpp"
+#include "norm2tex/texture/atlas_cache.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/common/image_io.hpp"
+#include "norm2tex/materials/material_texture.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/render/tactile_renderer.hpp"
 #include "package_paths.hpp"
 #include "quiet_stderr.hpp"
 

@@ -6,10 +6,10 @@
 #include <unistd.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/atlas_cache.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/texture/atlas_cache.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

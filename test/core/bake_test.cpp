@@ -4,11 +4,11 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/height_atlas_baker.hpp"
-#include "norm2tex/normal_encoding.hpp"
-#include "norm2tex/uv_islands.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
+#include "norm2tex/texture/uv_islands.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

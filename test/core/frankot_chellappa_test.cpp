@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/frankot_chellappa.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/frankot_chellappa.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

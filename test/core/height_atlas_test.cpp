@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/height_atlas.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/height_atlas.hpp"
 
 namespace norm2tex {
 namespace {

@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/height_range.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/height_range.hpp"
 
 namespace norm2tex {
 namespace {

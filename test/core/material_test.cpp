@@ -15,12 +15,12 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/height_atlas_baker.hpp"
-#include "norm2tex/material_config.hpp"
-#include "norm2tex/normal_encoding.hpp"
-#include "norm2tex/normal_map.hpp"
-#include "norm2tex/procedural_material.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
+#include "norm2tex/texture/normal_map.hpp"
+#include "norm2tex/materials/procedural_material.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

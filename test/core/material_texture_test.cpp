@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/material_texture.hpp"
-#include "norm2tex/mesh_primitives.hpp"
-#include "norm2tex/normal_map.hpp"
+#include "norm2tex/materials/material_texture.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/texture/normal_map.hpp"
 
 namespace norm2tex {
 namespace {

@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/textured_mesh.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/mesh/textured_mesh.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/normal_encoding.hpp"
-#include "norm2tex/normal_map.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
+#include "norm2tex/texture/normal_map.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/mesh_primitives.hpp"
-#include "norm2tex/tactile_renderer.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/render/tactile_renderer.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

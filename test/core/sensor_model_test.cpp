@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "norm2tex/error.hpp"
-#include "norm2tex/sensor_model.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/render/sensor_model.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

@@ -12,8 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/digit_shader.hpp"
-#include "norm2tex/error.hpp"
+#include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/common/error.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
 
 namespace norm2tex {
 namespace test {

@@ -9,9 +9,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/error.hpp"
-#include "norm2tex/normal_map.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/normal_map.hpp"
 
 namespace norm2tex {
 namespace test {

@@ -9,8 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_runner.hpp"
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
 
 namespace {
 namespace fs = std::filesystem;

@@ -8,8 +8,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli_runner.hpp"
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
 
 namespace {
 namespace fs = std::filesystem;

@@ -8,9 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "cli_runner.hpp"
-#include "norm2tex/mesh_primitives.hpp"
-#include "norm2tex/textured_mesh.hpp"
-#include "norm2tex/uv_unwrap.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/mesh/textured_mesh.hpp"
+#include "norm2tex/mesh/uv_unwrap.hpp"
 
 namespace {
 namespace fs = std::filesystem;

@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "norm2tex/procedural_material.hpp"
+#include "norm2tex/materials/procedural_material.hpp"
 
 namespace norm2tex {
 namespace materials {

@@ -1,9 +1,9 @@
 // BM_Bake/<size>/islands:<n>: normal map -> H_global, paper defaults, one core.
 #include <benchmark/benchmark.h>
 
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/height_atlas_baker.hpp"
-#include "norm2tex/normal_encoding.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
 
 namespace {
 

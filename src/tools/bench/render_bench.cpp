@@ -5,14 +5,14 @@
 
 #include <benchmark/benchmark.h>
 
-#include "norm2tex/analytic_surface.hpp"
-#include "norm2tex/contact_rasterizer.hpp"
-#include "norm2tex/gel_model.hpp"
-#include "norm2tex/height_atlas_baker.hpp"
-#include "norm2tex/mesh_primitives.hpp"
-#include "norm2tex/normal_encoding.hpp"
-#include "norm2tex/tactile_renderer.hpp"
-#include "norm2tex/texture_overlay.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/render/contact_rasterizer.hpp"
+#include "norm2tex/render/gel_model.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
+#include "norm2tex/render/tactile_renderer.hpp"
+#include "norm2tex/render/texture_overlay.hpp"
 
 namespace {
 

@@ -2,8 +2,8 @@
 // (height field + 16-bit encoding); BM_Unwrap_200kTriangles: an automatic atlas.
 #include <benchmark/benchmark.h>
 
-#include "norm2tex/material_texture.hpp"
-#include "norm2tex/mesh_primitives.hpp"
+#include "norm2tex/materials/material_texture.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
 
 namespace {
 

@@ -1,0 +1,34 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "norm2tex/render/sensor_model.hpp"
+
+namespace norm2tex {
+
+/// The elastomer's response to an indentation field. The gel conforms to the object where it
+/// touches (the core) but cannot follow a sharp step at the contact's rim: around the contact it
+/// is dragged along in a smooth skirt.
+///
+/// Model (Taxim-style, made cheap): the core is every pixel indented more than
+/// core_fraction x the maximum indentation (0 = the whole contact, which keeps the texture
+/// everywhere the object touches; Taxim uses 0.4). A pyramid of Gaussian blurs
+/// (pyramid_sigmas_mm, coarse to fine; Taxim's kernels give 1.0, 0.5, 0.25, 0.1 mm) spreads the
+/// indentation outwards, the core being restored after each level. Levels of at least 1.5
+/// quarter-resolution pixels (0.5 mm at QVGA) run at a quarter of the resolution, where they cost
+/// almost nothing, and their skirt is upsampled bilinearly; finer levels run at full resolution
+/// around the deformation only. A last blur of final_sigma_mm stands for the gel's bending
+/// stiffness, then the result is clamped to [0, gel thickness] and deformations under 0.1 um are
+/// set to exactly 0 (so the gel away from the contact is exactly flat).
+class GelModel {
+ public:
+  explicit GelModel(const SensorModel& model);
+
+  /// `indentation_mm` CV_32FC1 of image size (>= 0); writes the gel's deformation (mm).
+  void apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const;
+
+ private:
+  SensorModel model_;
+};
+
+}  // namespace norm2tex

@@ -1,0 +1,67 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "norm2tex/render/contact_rasterizer.hpp"
+#include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/render/gel_model.hpp"
+#include "norm2tex/texture/height_atlas.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/render/texture_overlay.hpp"
+#include "norm2tex/mesh/textured_mesh.hpp"
+
+namespace norm2tex {
+
+/// One rendered DIGIT frame and the fields behind it.
+struct TactileFrame {
+  cv::Mat3b image;         ///< bgr8, what the DIGIT publishes
+  cv::Mat1f gel_mm;        ///< the gel's deformation after GelModel (indentation, mm)
+  cv::Mat1b contact_mask;  ///< 255 where the object touches the gel (H_final > 0)
+  ContactRaster raster;    ///< H_sensor, UVs, faces
+  cv::Mat1f h_local;       ///< H_local where textured, else empty
+  bool textured = false;   ///< whether the overlay ran
+
+  /// gel_mm in metres (32FC1), as published on the depth topic.
+  cv::Mat1f depthMetres() const;
+};
+
+/// The whole pipeline for one sensor: pose -> ContactRasterizer (H_sensor) -> TextureOverlay
+/// (H_final = H_sensor + beta H_local) -> GelModel -> DigitShader. Holds its buffers; not
+/// thread-safe (use one per thread or sensor).
+class TactileRenderer {
+ public:
+  /// Background: the model's background_image if set, else the synthetic one.
+  explicit TactileRenderer(const SensorModel& model);
+  TactileRenderer(const SensorModel& model, cv::Mat3b background);
+
+  /// The object to render. `atlas` may be null or `beta_mm` 0: textureless. Returns a warning
+  /// (empty if none), e.g. when texture was asked for but the mesh has no UVs.
+  std::string setObject(std::shared_ptr<const TexturedMesh> mesh,
+                        std::shared_ptr<const HeightAtlas> atlas = nullptr, double beta_mm = 0.0);
+
+  /// Renders the object at `object_in_gel` (metres, gel frame). `noise_seed` < 0: no noise.
+  /// Throws Error for a non-finite pose or when no object was set.
+  const TactileFrame& render(const Eigen::Isometry3d& object_in_gel, std::int64_t noise_seed);
+
+  const SensorModel& model() const { return model_; }
+  const DigitShader& shader() const { return shader_; }
+
+ private:
+  SensorModel model_;
+  ContactRasterizer rasterizer_;
+  GelModel gel_;
+  DigitShader shader_;
+  std::shared_ptr<const TexturedMesh> mesh_;
+  std::optional<TextureOverlay> overlay_;
+  TactileFrame frame_;
+  cv::Mat1f h_final_;
+  cv::Rect overlay_box_;  // what the overlay wrote last frame
+};
+
+}  // namespace norm2tex

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "norm2tex/texture/height_atlas.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+
+namespace norm2tex {
+
+/// A disk cache of baked HeightAtlases so a node restart does not re-bake.
+///
+/// The key is a hash of everything the bake depends on: the bytes of the normal map and of the
+/// mask file, every BakeOptions field and the cache format version (not the path: moving a file
+/// keeps its entry). An entry is three files in the cache directory: `<key>.tiff` (H_global,
+/// 32-bit float), `<key>.valid.png` (mask) and `<key>.yaml` (metadata: source path and hash,
+/// convention, parameters, island count), each written to a temporary name and renamed, the
+/// yaml last, so a crash mid-write leaves no entry that looks complete.
+class AtlasCache {
+ public:
+  /// `directory` is created on first store.
+  explicit AtlasCache(std::string directory);
+
+  /// $NORM2TEX_CACHE_DIR, else $XDG_CACHE_HOME/norm2tex, else $HOME/.cache/norm2tex.
+  static std::string defaultDirectory();
+
+  /// Throws Error if a file cannot be read.
+  std::string key(const std::string& normal_map_path, const std::string& mask_path,
+                  const BakeOptions& options) const;
+
+  /// The cached atlas for `key`, or nothing if absent or unreadable (a damaged entry is a miss).
+  std::optional<HeightAtlas> load(const std::string& key) const;
+
+  /// Stores an entry; throws Error when the directory or a file cannot be written.
+  void store(const std::string& key, const HeightAtlas& atlas, const std::string& normal_map_path,
+             const std::string& mask_path, const BakeOptions& options) const;
+
+  /// What loadOrBake did.
+  struct Result {
+    HeightAtlas atlas;
+    bool was_cached = false;
+    /// Non-empty when the bake succeeded but could not be stored (read-only or full disk):
+    /// the atlas is still good, the next start will bake again.
+    std::string store_error;
+  };
+
+  /// Cached atlas if present, else NormalMap::load + bakeHeightAtlas + store. Throws Error for
+  /// bad input (the normal map or mask cannot be used), never for a cache that cannot be written.
+  Result loadOrBake(const std::string& normal_map_path, const std::string& mask_path,
+                    const BakeOptions& options, const BakeProgress& progress = {}) const;
+
+  const std::string& directory() const { return directory_; }
+
+ private:
+  std::string directory_;
+};
+
+}  // namespace norm2tex

@@ -1,0 +1,118 @@
+#include "norm2tex/materials/material_texture.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
+
+namespace norm2tex {
+namespace {
+
+/// Normal map (BGRA, alpha = valid) from a height field in mm with a per-texel resolution.
+cv::Mat encodeWithAlpha(const cv::Mat1f& height_mm, const cv::Mat1f& mm_per_texel,
+                        const cv::Mat1b& valid, int depth) {
+  if (depth != CV_8U && depth != CV_16U) throw Error("normal map depth must be 8 or 16 bit");
+  cv::Mat1f height_texels(height_mm.size(), 0.0f);
+  cv::divide(height_mm, mm_per_texel, height_texels);
+  height_texels.setTo(0.0f, valid == 0);
+  const cv::Mat normals =
+      encodeNormalMapFromHeight(height_texels, NormalConvention::kOpenGL, depth, valid);
+  cv::Mat alpha;
+  valid.convertTo(alpha, depth, depth == CV_8U ? 1.0 : 257.0);
+  cv::Mat bgra;
+  cv::merge(std::vector<cv::Mat>{normals, alpha}, bgra);
+  return bgra;
+}
+
+}  // namespace
+
+MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, int size,
+                                      double mm_per_texel, int depth) {
+  if (size < 2 || size > 16384) throw Error("texture size must be in [2, 16384] texels");
+  if (!(mm_per_texel > 0.0 && mm_per_texel <= 10.0)) {
+    throw Error("mm_per_texel = " + std::to_string(mm_per_texel) +
+                " is out of range; valid: (0, 10]");
+  }
+  MaterialTexture texture;
+  const cv::Size extent(size, size);
+  texture.height_mm = material.renderHeightMm(extent, mm_per_texel);
+  texture.albedo = material.renderAlbedo(extent, mm_per_texel);
+  texture.valid = cv::Mat1b(extent, 255);
+  texture.mm_per_texel = cv::Mat1f(extent, static_cast<float>(mm_per_texel));
+  texture.normal_map =
+      encodeWithAlpha(texture.height_mm, texture.mm_per_texel, texture.valid, depth);
+  return texture;
+}
+
+MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const UvLayout& layout,
+                                      int depth, int padding_texels) {
+  const cv::Size extent = layout.island.size();
+  if (extent.width != extent.height || extent.width < 2) {
+    throw Error("renderMaterialTexture: the UV layout must be square");
+  }
+  MaterialTexture texture;
+  texture.height_mm = cv::Mat1f(extent, 0.0f);
+  texture.albedo = cv::Mat3b(extent, cv::Vec3b(0, 0, 0));
+  texture.valid = layout.island > 0;
+  texture.mm_per_texel = cv::Mat1f(extent, 0.0f);
+  // Bounding box of each island, to evaluate the material only where that island lies.
+  const int islands = static_cast<int>(layout.metres_per_uv.size());
+  std::vector<cv::Rect> boxes(islands);
+  for (int r = 0; r < extent.height; ++r) {
+    const int* row = layout.island.ptr<int>(r);
+    for (int c = 0; c < extent.width; ++c) {
+      if (row[c] <= 0 || row[c] >= islands) continue;
+      boxes[row[c]] |= cv::Rect(c, r, 1, 1);
+    }
+  }
+  for (int id = 1; id < islands; ++id) {
+    if (boxes[id].empty()) continue;
+    // Texel (r, c) sits at u = (c + 0.5) / W, 1 - v = (r + 0.5) / H: in this island's mm
+    // coordinates that is ((c + 0.5) * s, (r + 0.5) * s) with s = mm per UV unit / W.
+    const double mm_per_texel = layout.metres_per_uv[id] * 1e3 / extent.width;
+    const cv::Rect box = boxes[id];
+    const cv::Point2d origin(box.x * mm_per_texel, box.y * mm_per_texel);
+    const cv::Mat1b mask = layout.island(box) == id;
+    material.renderHeightMm(box.size(), mm_per_texel, origin).copyTo(texture.height_mm(box), mask);
+    material.renderAlbedo(box.size(), mm_per_texel, origin).copyTo(texture.albedo(box), mask);
+    texture.mm_per_texel(box).setTo(static_cast<float>(mm_per_texel), mask);
+  }
+  cv::Mat1f safe_resolution = texture.mm_per_texel.clone();
+  safe_resolution.setTo(1.0f, texture.valid == 0);  // avoids 0/0 outside islands
+  texture.normal_map = encodeWithAlpha(texture.height_mm, safe_resolution, texture.valid, depth);
+
+  // Padding: colours (not alpha) grow outwards so bilinear look-ups at borders stay on-island.
+  if (padding_texels > 0) {
+    std::vector<cv::Mat> channels;
+    cv::split(texture.normal_map, channels);
+    cv::Mat bgr;
+    cv::merge(std::vector<cv::Mat>{channels[0], channels[1], channels[2]}, bgr);
+    padIslands(bgr, layout.island, padding_texels);
+    cv::Mat albedo = texture.albedo;
+    padIslands(albedo, layout.island, padding_texels);
+    std::vector<cv::Mat> padded;
+    cv::split(bgr, padded);
+    padded.push_back(channels[3]);
+    cv::merge(padded, texture.normal_map);
+  }
+  return texture;
+}
+
+HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, TexturedMesh& mesh,
+                              int padding_texels) {
+  if (!mesh.hasUvs()) {
+    UnwrapOptions options;
+    options.texture_size = config.size;
+    options.padding_texels = padding_texels;
+    mesh = unwrapUvs(mesh, options).mesh;
+  }
+  const auto material = makeMaterialVariant(config, 0, seed);
+  const MaterialTexture texture = renderMaterialTexture(
+      *material, computeUvLayout(mesh, cv::Size(config.size, config.size)), CV_16U, padding_texels);
+  BakeOptions options;
+  options.range = config.range;
+  return bakeHeightAtlas(NormalMap::fromImage(texture.normal_map, options.normal_map), options);
+}
+
+}  // namespace norm2tex

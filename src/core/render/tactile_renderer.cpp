@@ -1,0 +1,74 @@
+#include "norm2tex/render/tactile_renderer.hpp"
+
+#include "norm2tex/common/error.hpp"
+
+namespace norm2tex {
+namespace {
+
+cv::Mat3b backgroundFor(const SensorModel& model) {
+  validate(model);
+  return model.background_image.empty() ? makeSyntheticBackground(model.imageSize())
+                                        : loadBackground(model.background_image, model.imageSize());
+}
+
+}  // namespace
+
+cv::Mat1f TactileFrame::depthMetres() const {
+  cv::Mat1f metres;
+  gel_mm.convertTo(metres, CV_32F, 1e-3);
+  return metres;
+}
+
+TactileRenderer::TactileRenderer(const SensorModel& model)
+    : TactileRenderer(model, backgroundFor(model)) {}
+
+TactileRenderer::TactileRenderer(const SensorModel& model, cv::Mat3b background)
+    : model_(model), rasterizer_(model), gel_(model), shader_(model, std::move(background)) {}
+
+std::string TactileRenderer::setObject(std::shared_ptr<const TexturedMesh> mesh,
+                                       std::shared_ptr<const HeightAtlas> atlas, double beta_mm) {
+  if (!mesh) throw Error("TactileRenderer::setObject: no mesh");
+  if (!(beta_mm >= 0.0 && beta_mm <= 10.0)) {
+    throw Error("beta = " + std::to_string(beta_mm) + " mm is out of range; valid: [0, 10] mm");
+  }
+  overlay_.reset();
+  mesh_ = std::move(mesh);
+  if (!atlas || beta_mm == 0.0) return "";  // textureless: no UV raster, no overlay
+  overlay_.emplace(std::move(atlas), beta_mm);
+  if (!mesh_->hasUvs()) {
+    const std::string name =
+        mesh_->sourcePath().empty() ? "the mesh" : "'" + mesh_->sourcePath() + "'";
+    return "texture needs UVs but " + name + " has none: rendering H_sensor only";
+  }
+  return "";
+}
+
+const TactileFrame& TactileRenderer::render(const Eigen::Isometry3d& object_in_gel,
+                                            std::int64_t noise_seed) {
+  if (!mesh_) throw Error("TactileRenderer::render: no object set");
+  const bool textured = overlay_.has_value() && mesh_->hasUvs();
+  rasterizer_.rasterize(*mesh_, object_in_gel, textured ? overlay_->reachMm() : 0.0, textured,
+                        frame_.raster);
+  const cv::Mat1f* h_final = &frame_.raster.h_sensor_mm;
+  if (textured) {
+    // The overlay writes only the covered box: clear what the previous frame wrote.
+    if (!overlay_box_.empty() && h_final_.size() == model_.imageSize()) {
+      h_final_(overlay_box_).setTo(0.0f);
+      frame_.h_local(overlay_box_).setTo(0.0f);
+    }
+    overlay_->apply(frame_.raster, model_.gel_thickness_mm, h_final_, &frame_.h_local);
+    overlay_box_ = frame_.raster.covered_box;
+    h_final = &h_final_;
+  } else {
+    frame_.h_local.release();
+    h_final_.release();
+    overlay_box_ = cv::Rect();
+  }
+  frame_.textured = textured;
+  cv::compare(*h_final, 0.0f, frame_.contact_mask, cv::CMP_GT);
+  gel_.apply(*h_final, frame_.gel_mm);
+  frame_.image = shader_.shade(frame_.gel_mm, noise_seed);
+  return frame_;
+}
+
+}  // namespace norm2tex

@@ -1,0 +1,150 @@
+#include "norm2tex/texture/atlas_cache.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/common/file_hash.hpp"
+#include "norm2tex/common/image_io.hpp"
+
+namespace norm2tex {
+namespace fs = std::filesystem;
+namespace {
+
+// Bump when the bake's output for the same input and options changes.
+constexpr int kFormatVersion = 1;
+
+std::string describeOptions(const BakeOptions& o) {
+  std::ostringstream text;
+  text << std::setprecision(17) << "convention=" << toString(o.normal_map.convention)
+       << ";min_nz=" << o.normal_map.min_nz << ";alpha_threshold=" << o.normal_map.alpha_threshold
+       << ";sigma_fine=" << o.sigma_fine << ";sigma_coarse=" << o.sigma_coarse
+       << ";alpha=" << o.alpha << ";percentile_low=" << o.percentile_low
+       << ";percentile_high=" << o.percentile_high << ";range=" << toString(o.range) << ";boundary="
+       << (o.integration.boundary == PoissonBoundary::kMirror ? "mirror" : "periodic")
+       << ";apron_refinements=" << o.integration.apron_refinements
+       << ";remove_mean_slope=" << o.remove_mean_slope;
+  return text.str();
+}
+
+std::string entryPath(const std::string& directory, const std::string& key,
+                      const std::string& suffix) {
+  return (fs::path(directory) / (key + suffix)).string();
+}
+
+}  // namespace
+
+AtlasCache::AtlasCache(std::string directory) : directory_(std::move(directory)) {
+  if (directory_.empty()) throw Error("AtlasCache: empty cache directory");
+}
+
+std::string AtlasCache::defaultDirectory() {
+  if (const char* explicit_dir = std::getenv("NORM2TEX_CACHE_DIR"); explicit_dir && *explicit_dir) {
+    return explicit_dir;
+  }
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
+    return (fs::path(xdg) / "norm2tex").string();
+  }
+  const char* home = std::getenv("HOME");
+  return (fs::path(home && *home ? home : "/tmp") / ".cache" / "norm2tex").string();
+}
+
+std::string AtlasCache::key(const std::string& normal_map_path, const std::string& mask_path,
+                            const BakeOptions& options) const {
+  std::uint64_t hash = fnv1a64("norm2tex-atlas-v" + std::to_string(kFormatVersion));
+  hash = fnv1a64(hashFile(normal_map_path), hash);
+  hash = fnv1a64(mask_path.empty() ? std::string("no-mask") : hashFile(mask_path), hash);
+  hash = fnv1a64(describeOptions(options), hash);
+  return toHex(hash);
+}
+
+std::optional<HeightAtlas> AtlasCache::load(const std::string& key) const {
+  const std::string metadata_path = entryPath(directory_, key, ".yaml");
+  std::error_code ec;
+  if (!fs::exists(metadata_path, ec)) return std::nullopt;  // written last: marks completion
+  try {
+    const YAML::Node metadata = YAML::LoadFile(metadata_path);
+    if (metadata["format_version"].as<int>() != kFormatVersion) return std::nullopt;
+    const cv::Mat heights = cv::imread(entryPath(directory_, key, ".tiff"), cv::IMREAD_UNCHANGED);
+    const cv::Mat valid =
+        cv::imread(entryPath(directory_, key, ".valid.png"), cv::IMREAD_GRAYSCALE);
+    if (heights.empty() || heights.type() != CV_32FC1 || valid.size() != heights.size() ||
+        heights.rows != metadata["rows"].as<int>() || heights.cols != metadata["cols"].as<int>()) {
+      return std::nullopt;
+    }
+    return HeightAtlas(heights, valid);
+  } catch (const std::exception&) {
+    return std::nullopt;  // a damaged entry is a miss; the next store replaces it
+  }
+}
+
+void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
+                       const std::string& normal_map_path, const std::string& mask_path,
+                       const BakeOptions& options) const {
+  std::error_code ec;
+  fs::create_directories(directory_, ec);
+  if (ec) throw Error("cannot create cache directory '" + directory_ + "': " + ec.message());
+  writeImage(entryPath(directory_, key, ".tiff"), atlas.heights());
+  writeImage(entryPath(directory_, key, ".valid.png"), atlas.valid());
+
+  YAML::Emitter yaml;
+  yaml << YAML::BeginMap;
+  yaml << YAML::Key << "format_version" << YAML::Value << kFormatVersion;
+  yaml << YAML::Key << "key" << YAML::Value << key;
+  yaml << YAML::Key << "source_path" << YAML::Value << fs::absolute(normal_map_path).string();
+  yaml << YAML::Key << "source_hash" << YAML::Value << hashFile(normal_map_path);
+  yaml << YAML::Key << "mask_path" << YAML::Value
+       << (mask_path.empty() ? std::string() : fs::absolute(mask_path).string());
+  yaml << YAML::Key << "mask_hash" << YAML::Value
+       << (mask_path.empty() ? std::string() : hashFile(mask_path));
+  yaml << YAML::Key << "parameters" << YAML::Value << describeOptions(options);
+  yaml << YAML::Key << "convention" << YAML::Value << toString(options.normal_map.convention);
+  yaml << YAML::Key << "range" << YAML::Value << toString(options.range);
+  yaml << YAML::Key << "rows" << YAML::Value << atlas.rows();
+  yaml << YAML::Key << "cols" << YAML::Value << atlas.cols();
+  yaml << YAML::Key << "island_count" << YAML::Value << atlas.islandCount();
+  yaml << YAML::EndMap;
+
+  const std::string final_path = entryPath(directory_, key, ".yaml");
+  const std::string temporary = final_path + ".tmp";
+  {
+    std::ofstream file(temporary);
+    file << yaml.c_str() << "\n";
+    file.flush();
+    if (!file) {
+      fs::remove(temporary, ec);
+      throw Error("cannot write cache metadata '" + temporary + "' (disk full?)");
+    }
+  }
+  fs::rename(temporary, final_path, ec);
+  if (ec) throw Error("cannot write cache metadata '" + final_path + "': " + ec.message());
+}
+
+AtlasCache::Result AtlasCache::loadOrBake(const std::string& normal_map_path,
+                                          const std::string& mask_path, const BakeOptions& options,
+                                          const BakeProgress& progress) const {
+  validate(options);
+  Result result;
+  const std::string cache_key = key(normal_map_path, mask_path, options);
+  if (std::optional<HeightAtlas> cached = load(cache_key)) {
+    result.atlas = std::move(*cached);
+    result.was_cached = true;
+    return result;
+  }
+  const NormalMap normal_map = NormalMap::load(normal_map_path, options.normal_map, mask_path);
+  result.atlas = bakeHeightAtlas(normal_map, options, progress);
+  try {
+    store(cache_key, result.atlas, normal_map_path, mask_path, options);
+  } catch (const Error& e) {
+    result.store_error = e.what();
+  }
+  return result;
+}
+
+}  // namespace norm2tex
