@@ -564,28 +564,35 @@ void smoothLabels(std::vector<Face>& faces, const Adjacency& adjacency, const Pl
   for (size_t f = 0; f < faces.size(); ++f) faces[f].cls = label[units.unit_of[f]];
 }
 
-}  // namespace
-
-UnwrapResult unwrapUvs(const TexturedMesh& mesh, const UnwrapOptions& options) {
+// Checks the options' ranges and that the mesh has triangles at all.
+void checkInputs(const TexturedMesh& mesh, const UnwrapOptions& options) {
   detail::requireParameter(options.texture_size >= 8 && options.texture_size <= 65536,
                            "unwrapUvs: texture_size", options.texture_size, "8..65536");
   detail::requireParameter(
       options.padding_texels >= 0 && options.padding_texels <= options.texture_size / 4,
       "unwrapUvs: padding_texels", options.padding_texels, "0..texture_size / 4");
-  const std::vector<Eigen::Vector3i>& triangles = mesh.triangles();
-  if (triangles.empty()) throw Error("unwrapUvs: the mesh is empty (no triangles)");
+  if (mesh.triangles().empty()) throw Error("unwrapUvs: the mesh is empty (no triangles)");
+}
 
-  // --- Faces on welded vertices, their normals and classes. ---
-  std::vector<int> representative;
-  const std::vector<int> welded = weldVertices(mesh.vertices(), representative);
+// Positions of the welded vertices in double: the charts are built on these.
+std::vector<Vec3> weldedPositions(const std::vector<Eigen::Vector3f>& vertices,
+                                  const std::vector<int>& representative) {
   std::vector<Vec3> positions(representative.size());
   for (size_t i = 0; i < representative.size(); ++i) {
-    positions[i] = mesh.vertices()[representative[i]].cast<double>();
+    positions[i] = vertices[representative[i]].cast<double>();
   }
-  const std::array<Vec3, 26> directions = chartDirections();
+  return positions;
+}
+
+// Faces on welded vertices with their unit normal (from the winding), area and nearest of the
+// 26 directions as class; degenerate faces keep a zero normal, zero area and class -1. Adds up
+// the mesh's area in total_area and throws when every face is degenerate.
+std::vector<Face> makeFaces(const std::vector<Eigen::Vector3i>& triangles,
+                            const std::vector<int>& welded, const std::vector<Vec3>& positions,
+                            const std::array<Vec3, 26>& directions, double& total_area) {
   const int face_count = static_cast<int>(triangles.size());
   std::vector<Face> faces(face_count);
-  double total_area = 0.0;
+  total_area = 0.0;
   for (int f = 0; f < face_count; ++f) {
     Face& face = faces[f];
     for (int k = 0; k < 3; ++k) face.v[k] = welded[triangles[f][k]];
@@ -613,243 +620,329 @@ UnwrapResult unwrapUvs(const TexturedMesh& mesh, const UnwrapOptions& options) {
     throw Error("unwrapUvs: all " + std::to_string(face_count) +
                 " triangles of the mesh are degenerate (zero area)");
   }
-  const Adjacency adjacency = buildAdjacency(faces, positions);
+  return faces;
+}
 
-  // Degenerate faces take a neighbour's class, so they join its chart (their own projection is
-  // a segment and claims no texel); isolated ones form their own tiny charts.
-  {
-    std::vector<int> queue;
-    for (int f = 0; f < face_count; ++f) {
-      if (faces[f].cls >= 0) queue.push_back(f);
-    }
-    for (size_t q = 0; q < queue.size(); ++q) {
-      const int f = queue[q];
-      for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
-        const int g = adjacency.neighbour[e];
-        if (faces[g].cls < 0) {
-          faces[g].cls = faces[f].cls;
-          queue.push_back(g);
-        }
+// Degenerate faces take a neighbour's class, so they join its chart (their own projection is
+// a segment and claims no texel); isolated ones form their own tiny charts.
+void classifyDegenerateFaces(std::vector<Face>& faces, const Adjacency& adjacency) {
+  const int face_count = static_cast<int>(faces.size());
+  std::vector<int> queue;
+  for (int f = 0; f < face_count; ++f) {
+    if (faces[f].cls >= 0) queue.push_back(f);
+  }
+  for (size_t q = 0; q < queue.size(); ++q) {
+    const int f = queue[q];
+    for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
+      const int g = adjacency.neighbour[e];
+      if (faces[g].cls < 0) {
+        faces[g].cls = faces[f].cls;
+        queue.push_back(g);
       }
     }
-    for (Face& face : faces) {
-      if (face.cls < 0) face.cls = 0;
-    }
   }
-
-  const PlanarUnits units = findPlanarUnits(faces, adjacency);
-  {
-    int non_degenerate = 0;
-    for (const Face& face : faces) non_degenerate += face.area > 0.0;
-    smoothLabels(faces, adjacency, units, directions,
-                 kSmoothness * std::sqrt(total_area / non_degenerate));
+  for (Face& face : faces) {
+    if (face.cls < 0) face.cls = 0;
   }
+}
 
-  // --- Charts: edge-connected components of one label. ---
-  std::vector<int> chart_of(face_count, -1);
-  std::vector<std::vector<int>> charts;
-  std::vector<double> chart_area;
-  std::vector<int> chart_class;
+// Weight lambda of the border length in smoothLabels: kSmoothness times the root of the mean
+// area of the non-degenerate faces, so the smoothing does not depend on the mesh's resolution.
+double borderWeight(const std::vector<Face>& faces, double total_area) {
+  int non_degenerate = 0;
+  for (const Face& face : faces) non_degenerate += face.area > 0.0;
+  return kSmoothness * std::sqrt(total_area / non_degenerate);
+}
+
+// Charts: edge-connected components of faces with one label.
+struct Charts {
+  std::vector<int> chart_of;            // per face
+  std::vector<std::vector<int>> faces;  // per chart; emptied when merged into another
+  std::vector<double> area;             // per chart
+  std::vector<int> cls;                 // per chart: index into chartDirections()
+};
+
+// Splits the labelled faces into edge-connected components of one label, in the order of
+// their first face.
+Charts findCharts(const std::vector<Face>& faces, const Adjacency& adjacency) {
+  const int face_count = static_cast<int>(faces.size());
+  Charts charts;
+  charts.chart_of.assign(face_count, -1);
   for (int seed = 0; seed < face_count; ++seed) {
-    if (chart_of[seed] >= 0) continue;
-    const int id = static_cast<int>(charts.size());
+    if (charts.chart_of[seed] >= 0) continue;
+    const int id = static_cast<int>(charts.faces.size());
     std::vector<int> members{seed};
-    chart_of[seed] = id;
+    charts.chart_of[seed] = id;
     double area = 0.0;
     for (size_t q = 0; q < members.size(); ++q) {
       const int f = members[q];
       area += faces[f].area;
       for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
         const int g = adjacency.neighbour[e];
-        if (chart_of[g] < 0 && faces[g].cls == faces[seed].cls) {
-          chart_of[g] = id;
+        if (charts.chart_of[g] < 0 && faces[g].cls == faces[seed].cls) {
+          charts.chart_of[g] = id;
           members.push_back(g);
         }
       }
     }
-    charts.push_back(std::move(members));
-    chart_area.push_back(area);
-    chart_class.push_back(faces[seed].cls);
+    charts.faces.push_back(std::move(members));
+    charts.area.push_back(area);
+    charts.cls.push_back(faces[seed].cls);
   }
+  return charts;
+}
 
-  // --- Fragments join the neighbour they share the longest border with. ---
-  {
-    const double cos_merge = std::cos(kMergeAngleDeg * kPi / 180.0);
-    std::vector<int> order(charts.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return chart_area[a] < chart_area[b]; });
-    std::vector<double> shared(charts.size(), 0.0);
-    std::vector<int> touched;
-    for (int c : order) {
-      if (chart_area[c] >= kFragmentOfMesh * total_area) break;
-      for (int f : charts[c]) {
-        for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
-          const int n = chart_of[adjacency.neighbour[e]];
-          if (n == c) continue;
-          if (shared[n] == 0.0) touched.push_back(n);
-          shared[n] += adjacency.length[e] + 1e-300;
-        }
+// Fragments (smallest first) join the neighbour they share the longest border with, when they
+// are small enough next to it and all their faces are within kMergeAngleDeg of its direction.
+void mergeFragments(Charts& charts, const std::vector<Face>& faces, const Adjacency& adjacency,
+                    const std::array<Vec3, 26>& directions, double total_area) {
+  const double cos_merge = std::cos(kMergeAngleDeg * kPi / 180.0);
+  std::vector<int> order(charts.faces.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return charts.area[a] < charts.area[b]; });
+  std::vector<double> shared(charts.faces.size(), 0.0);
+  std::vector<int> touched;
+  for (int c : order) {
+    if (charts.area[c] >= kFragmentOfMesh * total_area) break;
+    for (int f : charts.faces[c]) {
+      for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
+        const int n = charts.chart_of[adjacency.neighbour[e]];
+        if (n == c) continue;
+        if (shared[n] == 0.0) touched.push_back(n);
+        shared[n] += adjacency.length[e] + 1e-300;
       }
-      int best = -1;
-      for (int n : touched) {
-        if (best >= 0 && shared[n] <= shared[best]) continue;
-        if (!(chart_area[c] < kFragmentOfNeighbour * chart_area[n])) continue;
-        const Vec3& d = directions[chart_class[n]];
-        bool fits = true;
-        for (int f : charts[c]) {
-          if (faces[f].area > 0.0 && faces[f].normal.dot(d) < cos_merge) {
-            fits = false;
-            break;
-          }
-        }
-        if (fits) best = n;
-      }
-      for (int n : touched) shared[n] = 0.0;
-      touched.clear();
-      if (best < 0) continue;
-      for (int f : charts[c]) chart_of[f] = best;
-      charts[best].insert(charts[best].end(), charts[c].begin(), charts[c].end());
-      chart_area[best] += chart_area[c];
-      charts[c].clear();
-      chart_area[c] = 0.0;
     }
+    int best = -1;
+    for (int n : touched) {
+      if (best >= 0 && shared[n] <= shared[best]) continue;
+      if (!(charts.area[c] < kFragmentOfNeighbour * charts.area[n])) continue;
+      const Vec3& d = directions[charts.cls[n]];
+      bool fits = true;
+      for (int f : charts.faces[c]) {
+        if (faces[f].area > 0.0 && faces[f].normal.dot(d) < cos_merge) {
+          fits = false;
+          break;
+        }
+      }
+      if (fits) best = n;
+    }
+    for (int n : touched) shared[n] = 0.0;
+    touched.clear();
+    if (best < 0) continue;
+    for (int f : charts.faces[c]) charts.chart_of[f] = best;
+    charts.faces[best].insert(charts.faces[best].end(), charts.faces[c].begin(),
+                              charts.faces[c].end());
+    charts.area[best] += charts.area[c];
+    charts.faces[c].clear();
+    charts.area[c] = 0.0;
   }
+}
 
-  // --- Projection, overlap splitting and alignment of every chart. ---
+// Direction to project a chart along: the normal of the chart's largest planar unit when that
+// is most of the chart (planar faces stay exact), else the class's or the mean normal,
+// whichever is closer to the chart's worst face.
+Vec3 projectionDirection(const std::vector<int>& members, double chart_area,
+                         const Vec3& class_direction, const std::vector<Face>& faces,
+                         const PlanarUnits& units) {
   const double cos_max = std::cos(kMaxAngleDeg * kPi / 180.0);
-  std::vector<Piece> pieces;
-  std::vector<int> local_index(positions.size(), -1);
-  // Face state while splitting a chart: the chart's round number when pending, -1 when done.
-  std::vector<int> round_of(face_count, -1);
-  std::vector<int> tested_by(face_count, -1);
-  std::vector<std::array<Vec2, 3>> flat(face_count);
+  auto worstDot = [&](const Vec3& d) {
+    double worst = 2.0;
+    for (int f : members) {
+      if (faces[f].area > 0.0) worst = std::min(worst, faces[f].normal.dot(d));
+    }
+    return worst;
+  };
+  Vec3 direction = class_direction;
+  int largest = units.unit_of[members.front()];
+  Vec3 mean = Vec3::Zero();
+  for (int f : members) {
+    mean += faces[f].area * faces[f].normal;
+    if (units.area[units.unit_of[f]] > units.area[largest]) largest = units.unit_of[f];
+  }
+  const Vec3 planar = units.normal_sum[largest].normalized();
+  if (units.area[largest] >= 0.5 * chart_area && units.area[largest] > 0.0 &&
+      worstDot(planar) >= cos_max) {
+    direction = planar;
+  } else if (mean.norm() > 0.0) {
+    mean.normalize();
+    if (worstDot(mean) > worstDot(class_direction) + 1e-12) direction = mean;
+  }
+  return direction;
+}
+
+// Projects the chart's faces orthographically onto the plane normal to `direction` (flat[f],
+// in metres, u right and v up seen from the front) and returns their bounding box in lo, hi.
+void projectChart(const std::vector<int>& members, const Vec3& direction,
+                  const std::vector<Face>& faces, const std::vector<Vec3>& positions,
+                  std::vector<std::array<Vec2, 3>>& flat, Vec2& lo, Vec2& hi) {
+  Vec3 e1, e2;
+  projectionBasis(direction, e1, e2);
+  lo = Vec2::Constant(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  for (int f : members) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& p = positions[faces[f].v[k]];
+      flat[f][k] = Vec2(p.dot(e1), p.dot(e2));
+      lo = lo.cwiseMin(flat[f][k]);
+      hi = hi.cwiseMax(flat[f][k]);
+    }
+  }
+}
+
+// Per-face and per-vertex scratch state for splitting charts into pieces, shared by all charts
+// (the round and query counters only grow, so stale marks never match).
+struct SplitState {
+  // Per face: the chart's current round when pending, -1 when accepted, -2 when rejected in the
+  // current round.
+  std::vector<int> round_of;
+  std::vector<int> tested_by;    // per face: the last overlap query that tested it
+  std::vector<int> local_index;  // per welded vertex: its index in the current piece, or -1
+  std::vector<std::array<Vec2, 3>> flat;  // per face: its projected corners
   int round = 0, query = 0;
-  for (size_t c = 0; c < charts.size(); ++c) {
-    const std::vector<int>& members = charts[c];
+};
+
+// One splitting round: grows a piece from the first pending face through edges; a face whose
+// projection would overlap the piece's accepted faces stays pending and seeds a later piece of
+// the same chart. Returns the piece (faces only) and removes its faces from `pending`.
+Piece growPiece(std::vector<int>& pending, const std::vector<Face>& faces,
+                const Adjacency& adjacency, double eps, TriangleGrid& grid, SplitState& state) {
+  const int round = ++state.round;
+  for (int f : pending) state.round_of[f] = round;
+  Piece piece;
+  std::vector<int>& accepted = piece.faces;
+  auto tryAccept = [&](int f) {
+    const std::array<Vec2, 3>& t = state.flat[f];
+    const Vec2 t_lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+    const Vec2 t_hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+    const bool flat_face =
+        faces[f].area <= 0.0 || std::abs(cross2(t[1] - t[0], t[2] - t[0])) <= eps * eps;
+    if (!flat_face) {
+      const int query = ++state.query;
+      const bool overlaps = grid.anyInBox(t_lo, t_hi, [&](int g) {
+        if (state.tested_by[g] == query) return false;
+        state.tested_by[g] = query;
+        return interiorsOverlap(t, state.flat[g], eps);
+      });
+      if (overlaps) return false;
+      grid.insert(t_lo, t_hi, f);
+    }
+    state.round_of[f] = -1;
+    accepted.push_back(f);
+    return true;
+  };
+  tryAccept(pending.front());
+  for (size_t q = 0; q < accepted.size(); ++q) {
+    const int f = accepted[q];
+    for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
+      const int g = adjacency.neighbour[e];
+      // Tested once per round: rejected faces are marked -2 until the next round.
+      if (state.round_of[g] == round && !tryAccept(g)) state.round_of[g] = -2;
+    }
+  }
+  std::vector<int> rest;
+  for (int f : pending) {
+    if (state.round_of[f] != -1) rest.push_back(f);
+  }
+  pending.swap(rest);
+  grid.clear();
+  return piece;
+}
+
+// Gives the piece its welded vertices (in order of first use by its faces) and their projected
+// coordinates.
+void collectPieceVertices(Piece& piece, const std::vector<Face>& faces, SplitState& state) {
+  for (int f : piece.faces) {
+    for (int k = 0; k < 3; ++k) {
+      const int v = faces[f].v[k];
+      if (state.local_index[v] >= 0) continue;
+      state.local_index[v] = static_cast<int>(piece.vertices.size());
+      piece.vertices.push_back(v);
+      piece.local.push_back(state.flat[f][k]);
+    }
+  }
+  for (int v : piece.vertices) state.local_index[v] = -1;
+}
+
+// Projects every chart onto its plane and splits it where its projection would overlap itself:
+// the pieces to pack, each turned to its minimum-area bounding rectangle.
+std::vector<Piece> makePieces(const Charts& charts, const std::vector<Face>& faces,
+                              const Adjacency& adjacency, const PlanarUnits& units,
+                              const std::vector<Vec3>& positions,
+                              const std::array<Vec3, 26>& directions) {
+  const int face_count = static_cast<int>(faces.size());
+  std::vector<Piece> pieces;
+  SplitState state;
+  state.round_of.assign(face_count, -1);
+  state.tested_by.assign(face_count, -1);
+  state.local_index.assign(positions.size(), -1);
+  state.flat.resize(face_count);
+  for (size_t c = 0; c < charts.faces.size(); ++c) {
+    const std::vector<int>& members = charts.faces[c];
     if (members.empty()) continue;
-    // Direction: the normal of the chart's largest planar unit when that is most of the chart
-    // (planar faces stay exact), else the class's or the mean normal, whichever is closer to the
-    // chart's worst face.
-    auto worstDot = [&](const Vec3& d) {
-      double worst = 2.0;
-      for (int f : members) {
-        if (faces[f].area > 0.0) worst = std::min(worst, faces[f].normal.dot(d));
-      }
-      return worst;
-    };
-    const Vec3& class_direction = directions[chart_class[c]];
-    Vec3 direction = class_direction;
-    int largest = units.unit_of[members.front()];
-    Vec3 mean = Vec3::Zero();
-    for (int f : members) {
-      mean += faces[f].area * faces[f].normal;
-      if (units.area[units.unit_of[f]] > units.area[largest]) largest = units.unit_of[f];
-    }
-    const Vec3 planar = units.normal_sum[largest].normalized();
-    if (units.area[largest] >= 0.5 * chart_area[c] && units.area[largest] > 0.0 &&
-        worstDot(planar) >= cos_max) {
-      direction = planar;
-    } else if (mean.norm() > 0.0) {
-      mean.normalize();
-      if (worstDot(mean) > worstDot(class_direction) + 1e-12) direction = mean;
-    }
-    Vec3 e1, e2;
-    projectionBasis(direction, e1, e2);
-    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity());
-    Vec2 hi = -lo;
-    for (int f : members) {
-      for (int k = 0; k < 3; ++k) {
-        const Vec3& p = positions[faces[f].v[k]];
-        flat[f][k] = Vec2(p.dot(e1), p.dot(e2));
-        lo = lo.cwiseMin(flat[f][k]);
-        hi = hi.cwiseMax(flat[f][k]);
-      }
-    }
+    const Vec3 direction =
+        projectionDirection(members, charts.area[c], directions[charts.cls[c]], faces, units);
+    Vec2 lo, hi;
+    projectChart(members, direction, faces, positions, state.flat, lo, hi);
     const double eps = 1e-9 * (hi - lo).norm();
     TriangleGrid grid(lo, hi, members.size());
-
-    // Grow a piece from the first pending face through edges; a face that would overlap the
-    // piece's accepted faces stays pending and seeds a later piece of the same chart.
     std::vector<int> pending = members;
     while (!pending.empty()) {
-      ++round;
-      for (int f : pending) round_of[f] = round;
-      Piece piece;
-      std::vector<int>& accepted = piece.faces;
-      auto tryAccept = [&](int f) {
-        const std::array<Vec2, 3>& t = flat[f];
-        const Vec2 t_lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
-        const Vec2 t_hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
-        const bool flat_face =
-            faces[f].area <= 0.0 || std::abs(cross2(t[1] - t[0], t[2] - t[0])) <= eps * eps;
-        if (!flat_face) {
-          ++query;
-          const bool overlaps = grid.anyInBox(t_lo, t_hi, [&](int g) {
-            if (tested_by[g] == query) return false;
-            tested_by[g] = query;
-            return interiorsOverlap(t, flat[g], eps);
-          });
-          if (overlaps) return false;
-          grid.insert(t_lo, t_hi, f);
-        }
-        round_of[f] = -1;
-        accepted.push_back(f);
-        return true;
-      };
-      tryAccept(pending.front());
-      for (size_t q = 0; q < accepted.size(); ++q) {
-        const int f = accepted[q];
-        for (int e = adjacency.offset[f]; e < adjacency.offset[f + 1]; ++e) {
-          const int g = adjacency.neighbour[e];
-          // Tested once per round: rejected faces are marked with round + 1 until next round.
-          if (round_of[g] == round && !tryAccept(g)) round_of[g] = -2;
-        }
-      }
-      std::vector<int> rest;
-      for (int f : pending) {
-        if (round_of[f] != -1) rest.push_back(f);
-      }
-      pending.swap(rest);
-      grid.clear();
-
-      // Vertices of the piece and their coordinates.
-      for (int f : accepted) {
-        for (int k = 0; k < 3; ++k) {
-          const int v = faces[f].v[k];
-          if (local_index[v] >= 0) continue;
-          local_index[v] = static_cast<int>(piece.vertices.size());
-          piece.vertices.push_back(v);
-          piece.local.push_back(flat[f][k]);
-        }
-      }
-      for (int v : piece.vertices) local_index[v] = -1;
+      Piece piece = growPiece(pending, faces, adjacency, eps, grid, state);
+      collectPieceVertices(piece, faces, state);
       alignPiece(piece);
       pieces.push_back(std::move(piece));
     }
   }
+  return pieces;
+}
 
-  // --- Packing at one scale: the largest texels-per-metre that fits, by bisection. ---
-  const double texture = options.texture_size;
-  const double padding = options.padding_texels;
-  const double gap = padding + 1.0 + kMarginTexels;  // texel centres: padding empty between
-  const double border = padding + kMarginTexels;
-  const double container = texture + 1.0 - border;  // boxes carry their trailing gap
-  const int piece_count = static_cast<int>(pieces.size());
-  std::vector<int> order(piece_count);
+// Where the packed pieces go in the texture.
+struct Packing {
+  double scale = 0.0;                 // texels per metre, common to all pieces
+  double border = 0.0;                // texels kept empty along the texture's border
+  std::vector<Placement> placements;  // per piece
+};
+
+// Packing order: largest pieces first (by longer side, then shorter side), ties kept in order.
+std::vector<int> packingOrder(const std::vector<Piece>& pieces) {
+  std::vector<int> order(pieces.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     const double max_a = pieces[a].size.maxCoeff(), max_b = pieces[b].size.maxCoeff();
     if (max_a != max_b) return max_a > max_b;
     return pieces[a].size.minCoeff() > pieces[b].size.minCoeff();
   });
+  return order;
+}
+
+// Upper bound of the scale that fits: the pieces' total area may not exceed the container's,
+// nor may the longest piece (plus its gap) exceed its side. Infinite without any extent.
+double scaleUpperBound(const std::vector<Piece>& pieces, double container, double gap) {
   double area_sum = 0.0, longest = 0.0;
   for (const Piece& piece : pieces) {
     area_sum += piece.size.x() * piece.size.y();
     longest = std::max(longest, piece.size.maxCoeff());
   }
+  return std::min(
+      area_sum > 0.0 ? container / std::sqrt(area_sum) : std::numeric_limits<double>::infinity(),
+      longest > 0.0 ? (container - gap) / longest : std::numeric_limits<double>::infinity());
+}
+
+// Packs all pieces at one scale, with padding between them and to the border: the largest
+// texels-per-metre that fits, by bisection. Throws when not even their padding fits.
+Packing packPieces(const std::vector<Piece>& pieces, const UnwrapOptions& options) {
+  const double texture = options.texture_size;
+  const double padding = options.padding_texels;
+  const double gap = padding + 1.0 + kMarginTexels;  // texel centres: padding empty between
+  const double border = padding + kMarginTexels;
+  const double container = texture + 1.0 - border;  // boxes carry their trailing gap
+  const int piece_count = static_cast<int>(pieces.size());
+  const std::vector<int> order = packingOrder(pieces);
   std::vector<Vec2> boxes(piece_count);
-  std::vector<Placement> placements, best_placements;
+  std::vector<Placement> placements;
+  Packing packing;
+  packing.border = border;
   auto fits = [&](double scale) {
     for (int i = 0; i < piece_count; ++i) {
       boxes[i] = pieces[i].size * scale + Vec2::Constant(gap);
@@ -866,43 +959,51 @@ UnwrapResult unwrapUvs(const TexturedMesh& mesh, const UnwrapOptions& options) {
                "padding_texels";
     throw Error(message.str());
   }
-  best_placements = placements;
+  packing.placements = placements;
   double low = 0.0;
-  double high = std::min(
-      area_sum > 0.0 ? container / std::sqrt(area_sum) : std::numeric_limits<double>::infinity(),
-      longest > 0.0 ? (container - gap) / longest : std::numeric_limits<double>::infinity());
+  double high = scaleUpperBound(pieces, container, gap);
   if (!std::isfinite(high)) throw Error("unwrapUvs: the mesh has no extent to unwrap");
   if (fits(high)) {
     low = high;
-    best_placements = placements;
+    packing.placements = placements;
   } else {
     for (int iteration = 0; iteration < 48 && high - low > 1e-7 * high; ++iteration) {
       const double middle = 0.5 * (low + high);
       if (fits(middle)) {
         low = middle;
-        best_placements = placements;
+        packing.placements = placements;
       } else {
         high = middle;
       }
     }
   }
-  const double scale = low;  // texels per metre
-  if (!(scale > 0.0)) {
+  packing.scale = low;
+  if (!(packing.scale > 0.0)) {
     throw Error("unwrapUvs: the charts do not fit a " + std::to_string(options.texture_size) +
                 " texture at any scale; use a larger texture_size or fewer padding_texels");
   }
+  return packing;
+}
 
-  // --- Output: per piece its own vertices; triangles keep their index and corner order. ---
+// Writes the result mesh: per piece its own vertices (the original positions) with their UVs in
+// the packed texture; triangles keep their index and corner order.
+UnwrapResult makeResult(const TexturedMesh& mesh, const std::vector<int>& representative,
+                        const std::vector<Face>& faces, const std::vector<Piece>& pieces,
+                        const Packing& packing, const UnwrapOptions& options) {
+  const double texture = options.texture_size;
+  const double scale = packing.scale;
+  const int piece_count = static_cast<int>(pieces.size());
+  std::vector<int> local_index(representative.size(), -1);
   std::vector<Eigen::Vector3f> out_vertices;
   std::vector<Eigen::Vector2f> out_uvs;
-  std::vector<Eigen::Vector3i> out_triangles(face_count);
+  std::vector<Eigen::Vector3i> out_triangles(faces.size());
   for (int i = 0; i < piece_count; ++i) {
-    Piece& piece = pieces[i];
-    const Placement& placement = best_placements[i];
+    const Piece& piece = pieces[i];
+    const Placement& placement = packing.placements[i];
     const int base = static_cast<int>(out_vertices.size());
     const Vec2 size = placement.rotated ? Vec2(piece.size.y(), piece.size.x()) : piece.size;
-    const double left = border + placement.x;
-    const double top = border + placement.y;
+    const double left = packing.border + placement.x;
+    const double top = packing.border + placement.y;
     for (size_t k = 0; k < piece.vertices.size(); ++k) {
       const Vec2& p = piece.local[k];
       // A quarter turn (a, b) -> (h - b, a) keeps the orientation.
@@ -925,6 +1026,34 @@ UnwrapResult unwrapUvs(const TexturedMesh& mesh, const UnwrapOptions& options) {
   result.metres_per_uv = texture / scale;
   result.chart_count = piece_count;
   return result;
+}
+
+}  // namespace
+
+UnwrapResult unwrapUvs(const TexturedMesh& mesh, const UnwrapOptions& options) {
+  checkInputs(mesh, options);
+
+  // Faces on welded vertices, their normals and nearest directions.
+  std::vector<int> representative;
+  const std::vector<int> welded = weldVertices(mesh.vertices(), representative);
+  const std::vector<Vec3> positions = weldedPositions(mesh.vertices(), representative);
+  const std::array<Vec3, 26> directions = chartDirections();
+  double total_area = 0.0;
+  std::vector<Face> faces = makeFaces(mesh.triangles(), welded, positions, directions, total_area);
+  const Adjacency adjacency = buildAdjacency(faces, positions);
+
+  // Labels: nearest direction, smoothed over planar units.
+  classifyDegenerateFaces(faces, adjacency);
+  const PlanarUnits units = findPlanarUnits(faces, adjacency);
+  smoothLabels(faces, adjacency, units, directions, borderWeight(faces, total_area));
+
+  // Charts, projected and split into non-overlapping pieces, packed and written out.
+  Charts charts = findCharts(faces, adjacency);
+  mergeFragments(charts, faces, adjacency, directions, total_area);
+  const std::vector<Piece> pieces =
+      makePieces(charts, faces, adjacency, units, positions, directions);
+  const Packing packing = packPieces(pieces, options);
+  return makeResult(mesh, representative, faces, pieces, packing, options);
 }
 
 }  // namespace norm2tex
