@@ -1,0 +1,137 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include <Eigen/Geometry>
+
+#include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/sim/gripper_sim_config.hpp"
+
+namespace norm2tex {
+
+enum class Finger { kLeft = 0, kRight = 1 };
+
+/// What one gel feels, after the latest physics tick.
+struct GelContactState {
+  bool in_contact = false;
+  /// Total normal force the object presses into the gel with, N (>= 0).
+  double normal_force_n = 0.0;
+  /// Tangential force the object applies to the gel, N, in the gel frame (z is ~0).
+  Eigen::Vector3d shear_force_n = Eigen::Vector3d::Zero();
+  /// Deepest penetration of the object into the undeformed gel surface, metres (>= 0): the
+  /// indentation the renderer draws at this pose.
+  double penetration_m = 0.0;
+  /// Pose of the object frame in the gel frame (see SensorModel: +x image right, +y image
+  /// down, +z out of the gel).
+  Eigen::Isometry3d object_in_gel = Eigen::Isometry3d::Identity();
+};
+
+/// What reset() did.
+struct EpisodeStart {
+  std::uint32_t episode = 0;  ///< counts resets, from 1
+  std::uint64_t seed = 0;
+  double height_offset_m = 0.0;  ///< object centre above the gel centres
+  double grasp_opening = 0.0;    ///< normalised command the fingers closed to
+};
+
+/// A Bullet simulation of a parallel gripper whose two DIGIT gels hold an object.
+///
+/// World frame: z up, floor at z = 0. The gripper base sits at (0, 0, base_height) with the
+/// world's orientation; the fingers move along its y axis, the left finger at +y (REP-103:
+/// x forward, y left). Each finger frame sits at the centre of its undeformed gel surface;
+/// its gel frame (the renderer's) is rotated so +z points at the other finger and +y (image
+/// down) points down the finger, towards the floor.
+///
+/// Gel compliance: the gels are kinematic boxes with Bullet soft contacts (contact stiffness
+/// and damping, solved implicitly). Before every Bullet step each gel's contact stiffness is
+/// set to GelLaw::force(d) / sum(d_i) from the current penetrations d_i of its contact points
+/// (d = the deepest), so at rest the object sinks into each gel exactly as deep as the law
+/// says for the force it carries. Friction is the material's coefficient with friction anchors:
+/// a contact inside the Coulomb cone keeps its anchor, so a held object does not creep.
+///
+/// Fingers are position-controlled at max_speed, coupled (both at the same distance from the
+/// centre plane), and stop closing once either gel carries max_force: the grip force then comes
+/// from the gel law, and a command narrower than the object indents both gels.
+///
+/// Deterministic: the same config, reset seeds and commands give bit-identical trajectories.
+class GripperSim {
+ public:
+  /// Loads the object (loadObjectMesh) and builds the world with the object seated at the
+  /// episode's lowest height offset and the fingers open; call reset() to start an episode.
+  /// Throws Error for an invalid config, an unreadable mesh, or an object wider than max_gap.
+  explicit GripperSim(const GripperSimConfig& config);
+  ~GripperSim();
+  GripperSim(const GripperSim&) = delete;
+  GripperSim& operator=(const GripperSim&) = delete;
+
+  /// Re-seats the object between the open gels at `height_offset_m` (or, when absent, one drawn
+  /// uniformly from the configured range with `seed`), closes to the grasp opening without
+  /// gravity on the object, then lets it settle under gravity for episode.settle_s. Simulated
+  /// time keeps running through it. Throws Error for a non-finite offset.
+  EpisodeStart reset(std::uint64_t seed, std::optional<double> height_offset_m = std::nullopt);
+
+  /// Normalised opening command, 0 = closed (gap min_gap) ... 1 = open (gap max_gap). Throws
+  /// Error (and changes nothing) for NaN or values outside [0, 1].
+  void setOpening(double opening);
+  /// Adds `delta` to the current command, clamped to [0, 1]. Throws Error (and changes
+  /// nothing) for NaN or |delta| > 1.
+  void addOpening(double delta);
+  double commandedOpening() const { return command_; }
+  /// Where the fingers are now, as a normalised opening (may lag the command, or stop short of
+  /// it at the force limit).
+  double opening() const;
+  /// Gap between the undeformed gel surfaces for a normalised opening, metres.
+  double gapForOpening(double opening) const;
+
+  /// Advances `ticks` physics ticks of 1 / physics.rate_hz each.
+  void step(int ticks = 1);
+  double tickSeconds() const { return 1.0 / config_.physics.rate_hz; }
+  /// Ticks since construction (resets keep counting: simulated time never goes back).
+  std::int64_t ticks() const { return ticks_; }
+
+  const GelContactState& contact(Finger finger) const {
+    return contacts_[static_cast<int>(finger)];
+  }
+  Eigen::Isometry3d objectInWorld() const;
+  Eigen::Isometry3d baseInWorld() const;
+  /// Finger frame in the base frame: (0, +-position, 0), no rotation.
+  Eigen::Isometry3d fingerInBase(Finger finger) const;
+  /// Gel frame in its finger frame (a fixed rotation).
+  static Eigen::Isometry3d gelInFinger(Finger finger);
+  Eigen::Isometry3d gelInWorld(Finger finger) const;
+  /// Prismatic joint position of a finger: distance of its undeformed gel surface from the
+  /// centre plane, metres (both fingers are equal: they are coupled).
+  double fingerPosition() const { return finger_position_m_; }
+  /// Latched once the object has left both gels and fallen below their lower edge; cleared
+  /// by reset().
+  bool dropped() const { return dropped_; }
+
+  const GripperSimConfig& config() const { return config_; }
+  const ObjectMesh& object() const { return object_; }
+
+ private:
+  struct World;  // the Bullet objects
+
+  void buildWorld(double object_height_m);
+  void moveFingers(double dt);
+  void updateGelStiffness();
+  void measureContacts(double dt);
+  double objectWidthM() const;
+
+  GripperSimConfig config_;
+  ObjectMesh object_;
+  /// Object frame in the collision body's frame (the body sits at the bounds' centre).
+  Eigen::Isometry3d object_in_body_ = Eigen::Isometry3d::Identity();
+  std::unique_ptr<World> world_;
+  std::array<GelContactState, 2> contacts_;
+  double command_ = 1.0;
+  double finger_position_m_ = 0.0;
+  std::int64_t ticks_ = 0;
+  std::uint32_t episode_ = 0;
+  bool dropped_ = false;
+};
+
+}  // namespace norm2tex

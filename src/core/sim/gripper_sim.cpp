@@ -1,0 +1,410 @@
+#include "norm2tex/sim/gripper_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include <btBulletDynamicsCommon.h>
+
+#include <BulletCollision/CollisionShapes/btShapeHull.h>
+
+#include "norm2tex/common/error.hpp"
+
+namespace norm2tex {
+namespace {
+
+// Bullet's default 4 cm margins are larger than the gel's whole range: keep them far below the
+// indentations we resolve (box margins sit inside the box, so boxes stay exact).
+constexpr double kBoxMargin = 2e-4;
+constexpr double kHullMargin = 2e-5;
+// The fingers open this far beyond the object before an episode closes them.
+constexpr double kSeatClearance = 1e-3;
+// After the fingers reach the grasp command, the contact settles this long before gravity.
+constexpr double kGraspHoldS = 0.1;
+
+btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
+Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+btTransform toBt(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.rotation());
+  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), toBt(pose.translation()));
+}
+
+Eigen::Isometry3d toEigen(const btTransform& t) {
+  const btQuaternion q = t.getRotation();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
+  pose.translation() = toEigen(t.getOrigin());
+  return pose;
+}
+
+// Uniform in [0, 1) from a 64-bit engine, the same on every platform
+// (std::uniform_real_distribution is not specified bit for bit).
+double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+}  // namespace
+
+struct GripperSim::World {
+  btDefaultCollisionConfiguration collision_config;
+  btCollisionDispatcher dispatcher{&collision_config};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &collision_config};
+
+  std::unique_ptr<btCollisionShape> floor_shape;
+  std::unique_ptr<btCollisionShape> gel_shape;
+  std::unique_ptr<btCollisionShape> object_shape;
+  std::unique_ptr<btRigidBody> floor;
+  std::array<std::unique_ptr<btRigidBody>, 2> gels;
+  std::unique_ptr<btRigidBody> object;
+
+  ~World() {
+    if (object) world.removeRigidBody(object.get());
+    for (auto& gel : gels) {
+      if (gel) world.removeRigidBody(gel.get());
+    }
+    if (floor) world.removeRigidBody(floor.get());
+  }
+};
+
+namespace {
+
+std::unique_ptr<btCollisionShape> makeObjectShape(const ObjectMesh& object,
+                                                  const std::string& collision,
+                                                  const Eigen::Vector3d& centre) {
+  const Eigen::Vector3d half = object.mesh.bounds().sizes().cast<double>() / 2.0;
+  if (collision == "box" || (collision == "auto" && object.shape == ObjectMesh::Shape::kBox)) {
+    auto box = std::make_unique<btBoxShape>(toBt(half));
+    box->setMargin(std::min(kBoxMargin, 0.25 * half.minCoeff()));
+    return box;
+  }
+  // Spheres take their mesh's hull too (within 5 um of the sphere at 96 x 192): Bullet's
+  // sphere-box contact is a single point that did not hold a pinched ball (it slid 7 mm
+  // under its own weight at 2.6 N of grip), while the polyhedral hull holds it still.
+  // Convex hull of the render mesh's vertices about the body origin, reduced to at most a
+  // few hundred vertices (btShapeHull) so contact generation stays cheap for big meshes.
+  btConvexHullShape full;
+  for (const Eigen::Vector3f& v : object.mesh.vertices()) {
+    full.addPoint(toBt(v.cast<double>() - centre), false);
+  }
+  full.recalcLocalAabb();
+  full.setMargin(0.0);
+  btShapeHull reducer(&full);
+  reducer.buildHull(0.0);
+  auto hull = std::make_unique<btConvexHullShape>();
+  for (int i = 0; i < reducer.numVertices(); ++i)
+    hull->addPoint(reducer.getVertexPointer()[i], false);
+  hull->recalcLocalAabb();
+  hull->setMargin(kHullMargin);
+  return hull;
+}
+
+}  // namespace
+
+GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
+  validate(config_);
+  object_ = loadObjectMesh(config_.object.mesh, config_.object.scale);
+  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
+  object_in_body_ = Eigen::Translation3d(-centre);
+  if (objectWidthM() + 2 * kSeatClearance > config_.gripper.max_gap_m) {
+    std::ostringstream message;
+    message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
+            << " mm wide along the grip axis: more than gripper.max_gap_mm = "
+            << config_.gripper.max_gap_m * 1e3 << " minus 2 mm of clearance";
+    throw Error(message.str());
+  }
+  command_ = 1.0;
+  finger_position_m_ = config_.gripper.max_gap_m / 2.0;
+  buildWorld(config_.episode.height_offset_low_m);
+}
+
+GripperSim::~GripperSim() = default;
+
+double GripperSim::objectWidthM() const {
+  return static_cast<double>(object_.mesh.bounds().sizes().y());
+}
+
+double GripperSim::gapForOpening(double opening) const {
+  const GripperOptions& g = config_.gripper;
+  return g.min_gap_m + opening * (g.max_gap_m - g.min_gap_m);
+}
+
+double GripperSim::opening() const {
+  const GripperOptions& g = config_.gripper;
+  return (2.0 * finger_position_m_ - g.min_gap_m) / (g.max_gap_m - g.min_gap_m);
+}
+
+void GripperSim::setOpening(double opening) {
+  if (!(opening >= 0.0 && opening <= 1.0)) {
+    std::ostringstream message;
+    message << "gripper opening " << opening << " is out of range; valid: [0, 1] (0 = closed)";
+    throw Error(message.str());
+  }
+  command_ = opening;
+}
+
+void GripperSim::addOpening(double delta) {
+  if (!(std::abs(delta) <= 1.0)) {
+    std::ostringstream message;
+    message << "gripper opening delta " << delta << " is out of range; valid: [-1, 1]";
+    throw Error(message.str());
+  }
+  command_ = std::clamp(command_ + delta, 0.0, 1.0);
+}
+
+Eigen::Isometry3d GripperSim::baseInWorld() const {
+  return Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, config_.gripper.base_height_m));
+}
+
+Eigen::Isometry3d GripperSim::fingerInBase(Finger finger) const {
+  const double side = finger == Finger::kLeft ? 1.0 : -1.0;
+  return Eigen::Isometry3d(Eigen::Translation3d(0.0, side * finger_position_m_, 0.0));
+}
+
+Eigen::Isometry3d GripperSim::gelInFinger(Finger finger) {
+  // Columns: the gel's x (image right), y (image down = world -z), z (towards the other finger).
+  Eigen::Matrix3d r;
+  if (finger == Finger::kLeft) {
+    r << -1, 0, 0,  //
+        0, 0, -1,   //
+        0, -1, 0;
+  } else {
+    r << 1, 0, 0,  //
+        0, 0, 1,   //
+        0, -1, 0;
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = r;
+  return pose;
+}
+
+Eigen::Isometry3d GripperSim::gelInWorld(Finger finger) const {
+  return baseInWorld() * fingerInBase(finger) * gelInFinger(finger);
+}
+
+Eigen::Isometry3d GripperSim::objectInWorld() const {
+  return toEigen(world_->object->getWorldTransform()) * object_in_body_;
+}
+
+void GripperSim::buildWorld(double object_height_m) {
+  world_ = std::make_unique<World>();
+  btDiscreteDynamicsWorld& w = world_->world;
+  const PhysicsOptions& p = config_.physics;
+  w.setGravity(btVector3(0, 0, -p.gravity_m_s2));
+  btContactSolverInfo& solver = w.getSolverInfo();
+  solver.m_numIterations = p.solver_iterations;
+  solver.m_frictionERP = p.friction_erp;
+  // Two friction directions per contact: a held object resists slip along the gel in 2-D.
+  solver.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+
+  // Floor: where a dropped object ends up.
+  world_->floor_shape = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
+  world_->floor = std::make_unique<btRigidBody>(
+      btRigidBody::btRigidBodyConstructionInfo(0, nullptr, world_->floor_shape.get()));
+  world_->floor->setFriction(0.5);
+  w.addRigidBody(world_->floor.get());
+
+  // Gels: kinematic boxes behind the gel surface, soft-contact, with the material's friction
+  // (Bullet multiplies the two bodies' coefficients; the object's is 1).
+  const btVector3 gel_half(config_.gel_width_m / 2, config_.gel_height_m / 2,
+                           config_.gel_thickness_m / 2);
+  auto gel_box = std::make_unique<btBoxShape>(gel_half);
+  gel_box->setMargin(kBoxMargin);
+  world_->gel_shape = std::move(gel_box);
+  for (int i = 0; i < 2; ++i) {
+    btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, world_->gel_shape.get());
+    info.m_friction = config_.object.friction;
+    info.m_restitution = 0;
+    auto gel = std::make_unique<btRigidBody>(info);
+    gel->setCollisionFlags(gel->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT |
+                           btCollisionObject::CF_HAS_FRICTION_ANCHOR);
+    gel->setActivationState(DISABLE_DEACTIVATION);
+    gel->setContactStiffnessAndDamping(config_.gel_law.secantStiffness(0.0), p.gel_damping);
+    w.addRigidBody(gel.get());
+    world_->gels[i] = std::move(gel);
+  }
+
+  // Object: dynamic, its body at its bounds' centre.
+  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
+  world_->object_shape = makeObjectShape(object_, config_.object.collision, centre);
+  btVector3 inertia(0, 0, 0);
+  world_->object_shape->calculateLocalInertia(config_.object.mass_kg, inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(config_.object.mass_kg, nullptr,
+                                                world_->object_shape.get(), inertia);
+  info.m_friction = 1.0;
+  info.m_restitution = 0;
+  world_->object = std::make_unique<btRigidBody>(info);
+  world_->object->setActivationState(DISABLE_DEACTIVATION);
+  world_->object->setCollisionFlags(world_->object->getCollisionFlags() |
+                                    btCollisionObject::CF_HAS_FRICTION_ANCHOR);
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.translation() = Eigen::Vector3d(0, 0, config_.gripper.base_height_m + object_height_m);
+  world_->object->setWorldTransform(toBt(body));
+  w.addRigidBody(world_->object.get());
+
+  moveFingers(0.0);
+  contacts_ = {};
+  for (int i = 0; i < 2; ++i) {
+    contacts_[i].object_in_gel = gelInWorld(static_cast<Finger>(i)).inverse() * objectInWorld();
+  }
+}
+
+void GripperSim::moveFingers(double dt) {
+  // Coupled, speed-limited position control; the force limit stops closing (never opening).
+  const double target = gapForOpening(command_) / 2.0;
+  const double max_move = config_.gripper.max_speed_m_s * dt;
+  double next = finger_position_m_ + std::clamp(target - finger_position_m_, -max_move, max_move);
+  const double force = std::max(contacts_[0].normal_force_n, contacts_[1].normal_force_n);
+  if (next < finger_position_m_ && force >= config_.gripper.max_force_n) next = finger_position_m_;
+  finger_position_m_ = next;
+  for (int i = 0; i < 2; ++i) {
+    // The gel box's centre sits half a thickness behind the gel surface (gel -z).
+    const Eigen::Isometry3d box = gelInWorld(static_cast<Finger>(i)) *
+                                  Eigen::Translation3d(0, 0, -config_.gel_thickness_m / 2);
+    btRigidBody& gel = *world_->gels[i];
+    // Kinematic bodies: Bullet derives their velocity from the change of this transform.
+    gel.setWorldTransform(toBt(box));
+    gel.setInterpolationWorldTransform(gel.getWorldTransform());
+  }
+}
+
+void GripperSim::updateGelStiffness() {
+  // Secant stiffness of the law at the current penetration, shared among the contact points
+  // in proportion to their depth: sum_i k d_i = F(d_max).
+  btDispatcher& dispatcher = world_->dispatcher;
+  for (int i = 0; i < 2; ++i) {
+    btRigidBody* gel = world_->gels[i].get();
+    double deepest = 0.0, sum = 0.0;
+    std::vector<btPersistentManifold*> manifolds;
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+      if ((manifold->getBody0() == gel && manifold->getBody1() == world_->object.get()) ||
+          (manifold->getBody1() == gel && manifold->getBody0() == world_->object.get())) {
+        manifolds.push_back(manifold);
+        for (int c = 0; c < manifold->getNumContacts(); ++c) {
+          const double d = -manifold->getContactPoint(c).getDistance();
+          if (d > 0.0) {
+            deepest = std::max(deepest, d);
+            sum += d;
+          }
+        }
+      }
+    }
+    const double k =
+        sum > 0.0 ? config_.gel_law.force(deepest) / sum : config_.gel_law.secantStiffness(0.0);
+    gel->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
+    // Points kept by a friction anchor are not re-created by collision detection: set them too.
+    const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
+    for (btPersistentManifold* manifold : manifolds) {
+      for (int c = 0; c < manifold->getNumContacts(); ++c) {
+        btManifoldPoint& point = manifold->getContactPoint(c);
+        point.m_combinedContactStiffness1 = k;
+        point.m_combinedContactDamping1 = damping;
+        point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+      }
+    }
+  }
+}
+
+void GripperSim::measureContacts(double dt) {
+  btDispatcher& dispatcher = world_->dispatcher;
+  const Eigen::Isometry3d object_in_world = objectInWorld();
+  for (int i = 0; i < 2; ++i) {
+    const btRigidBody* gel = world_->gels[i].get();
+    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
+    GelContactState& state = contacts_[i];
+    state = GelContactState{};
+    state.object_in_gel = gel_in_world.inverse() * object_in_world;
+    Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+      const bool gel_is_a =
+          manifold->getBody0() == gel && manifold->getBody1() == world_->object.get();
+      const bool gel_is_b =
+          manifold->getBody1() == gel && manifold->getBody0() == world_->object.get();
+      if (!gel_is_a && !gel_is_b) continue;
+      for (int c = 0; c < manifold->getNumContacts(); ++c) {
+        const btManifoldPoint& point = manifold->getContactPoint(c);
+        state.penetration_m =
+            std::max(state.penetration_m, -static_cast<double>(point.getDistance()));
+        state.normal_force_n += point.getAppliedImpulse() / dt;
+        // Friction impulses act on body A along the lateral directions; the gel feels the
+        // object's reaction.
+        const Eigen::Vector3d on_a =
+            (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
+             toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
+            dt;
+        shear_world += gel_is_a ? on_a : Eigen::Vector3d(-on_a);
+      }
+    }
+    state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
+    state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
+    state.shear_force_n.z() = 0.0;
+  }
+  // Dropped: free of both gels and below their lower edge.
+  const double lower_edge = config_.gripper.base_height_m - config_.gel_height_m / 2.0;
+  if (!contacts_[0].in_contact && !contacts_[1].in_contact &&
+      object_in_world.translation().z() < lower_edge) {
+    dropped_ = true;
+  }
+}
+
+void GripperSim::step(int ticks) {
+  const int substeps = config_.physics.substeps;
+  const double dt = tickSeconds() / substeps;
+  for (int t = 0; t < ticks; ++t) {
+    for (int s = 0; s < substeps; ++s) {
+      moveFingers(dt);
+      updateGelStiffness();
+      world_->world.stepSimulation(dt, 0, dt);
+      measureContacts(dt);
+    }
+    ++ticks_;
+  }
+}
+
+EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_offset_m) {
+  const EpisodeOptions& e = config_.episode;
+  std::mt19937_64 rng(seed);
+  const double offset = height_offset_m
+                            ? *height_offset_m
+                            : e.height_offset_low_m +
+                                  uniform01(rng) * (e.height_offset_high_m - e.height_offset_low_m);
+  if (!std::isfinite(offset) || std::abs(offset) > 0.5) {
+    std::ostringstream message;
+    message << "height offset " << offset << " m is out of range; valid: finite, within 0.5 m";
+    throw Error(message.str());
+  }
+  EpisodeStart start;
+  start.episode = ++episode_;
+  start.seed = seed;
+  start.height_offset_m = offset;
+  const GripperOptions& g = config_.gripper;
+  start.grasp_opening =
+      e.grasp_opening >= 0.0
+          ? e.grasp_opening
+          : std::clamp((objectWidthM() - 2.0 * e.grasp_indentation_m - g.min_gap_m) /
+                           (g.max_gap_m - g.min_gap_m),
+                       0.0, 1.0);
+
+  // Seat the object between gels opened just wider than it, without gravity on it.
+  dropped_ = false;
+  command_ = std::clamp(
+      (objectWidthM() + 2 * kSeatClearance - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0, 1.0);
+  finger_position_m_ = gapForOpening(command_) / 2.0;
+  buildWorld(offset);
+  world_->object->setGravity(btVector3(0, 0, 0));
+
+  // Close to the grasp command; then hold, still weightless, until the contacts settle.
+  command_ = start.grasp_opening;
+  const double travel = std::abs(finger_position_m_ - gapForOpening(command_) / 2.0);
+  const int close_ticks = static_cast<int>(std::ceil(travel / g.max_speed_m_s / tickSeconds()));
+  step(close_ticks + static_cast<int>(std::ceil(kGraspHoldS / tickSeconds())));
+
+  world_->object->setGravity(world_->world.getGravity());
+  step(static_cast<int>(std::ceil(e.settle_s / tickSeconds())));
+  return start;
+}
+
+}  // namespace norm2tex
