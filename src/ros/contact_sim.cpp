@@ -1,0 +1,277 @@
+#include "contact_sim.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include <ros/package.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/JointState.h>
+
+#include "conversions.hpp"
+#include "norm2tex/TactileContact.h"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+
+namespace norm2tex {
+namespace {
+
+const char* const kSensorNames[2] = {"digit_left", "digit_right"};
+const char* const kGelFrames[2] = {"digit_left_gel", "digit_right_gel"};
+const char* const kFingerFrames[2] = {"finger_left", "finger_right"};
+
+std::string packageFile(const std::string& relative) {
+  return ros::package::getPath("norm2tex") + "/" + relative;
+}
+
+[[noreturn]] void badParameter(const std::string& name, const std::string& value,
+                               const std::string& valid) {
+  throw Error("~" + name + " = " + value + " is not valid; valid: " + valid);
+}
+
+template <typename T>
+std::string text(const T& value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
+  ContactSimParams p;
+  std::string mode = "real_time";
+  pnh.param<std::string>("mode", mode, mode);
+  if (mode != "real_time" && mode != "synchronous") {
+    badParameter("mode", "'" + mode + "'", "real_time, synchronous");
+  }
+  p.synchronous = mode == "synchronous";
+  pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
+  pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
+  pnh.param<std::string>("material", p.material, "wood");
+  p.material_config = packageFile("config/materials/" + p.material + ".yaml");
+  if (p.material.empty() || p.material.find('/') != std::string::npos ||
+      !std::filesystem::is_regular_file(p.material_config)) {
+    std::string valid;
+    for (const auto& entry : std::filesystem::directory_iterator(packageFile("config/materials"))) {
+      if (entry.path().extension() == ".yaml") {
+        valid += (valid.empty() ? "" : ", ") + entry.path().stem().string();
+      }
+    }
+    badParameter("material", "'" + p.material + "'", valid + " (config/materials/*.yaml)");
+  }
+  int seed = 0;
+  pnh.param("seed", seed, 0);
+  if (seed < 0) badParameter("seed", text(seed), ">= 0");
+  p.seed = seed;
+  pnh.param("height_offset", p.height_offset, std::nan(""));
+  pnh.param("physics_rate", p.physics_rate, p.physics_rate);
+  if (!(p.physics_rate >= 100.0 && p.physics_rate <= 100000.0)) {
+    badParameter("physics_rate", text(p.physics_rate), "[100, 100000] Hz");
+  }
+  pnh.param("frame_rate", p.frame_rate, p.frame_rate);
+  if (!(p.frame_rate >= 1.0 && p.frame_rate <= 1000.0 && p.frame_rate <= p.physics_rate)) {
+    badParameter("frame_rate", text(p.frame_rate), "[1, 1000] Hz and <= ~physics_rate");
+  }
+  pnh.param("variant", p.variant, 0);
+  if (p.variant < 0) badParameter("variant", text(p.variant), ">= 0");
+  pnh.param("beta", p.beta, -1.0);
+  pnh.param<std::string>("scenario", p.scenario, p.scenario);
+  return p;
+}
+
+ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : params_(readContactSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
+  const MaterialConfig material = loadMaterialConfig(params_.material_config);
+  beta_mm_ = params_.beta >= 0.0 ? params_.beta : material.beta_mm;
+  const SensorModel sensor = loadSensorModel(params_.sensor);
+  GripperSimConfig config = loadGripperSimConfig(params_.scene);
+  config.object.friction = material.friction;
+  config.object.material = params_.material;
+  setGelFromSensor(sensor, config);
+  // Whole physics ticks per sensor frame, so every frame's stamp is a physics state.
+  ticks_per_frame_ =
+      std::max(1, static_cast<int>(std::lround(params_.physics_rate / params_.frame_rate)));
+  config.physics.rate_hz = ticks_per_frame_ * params_.frame_rate;
+  frame_period_ns_ = std::llround(1e9 / params_.frame_rate);
+  sim_ = std::make_unique<GripperSim>(config);
+  for (int i = 0; i < 2; ++i) meters_[i] = std::make_unique<ContactPatchMeter>(sensor);
+
+  const bool use_sim_time = ros::Time::isSimTime();
+  if (params_.synchronous && !use_sim_time) {
+    throw Error(
+        "~mode = synchronous needs /use_sim_time = true (simulated time advances only "
+        "through ~step); set it before the nodes start, as gripper_sim.launch does");
+  }
+  owns_clock_ = use_sim_time;
+
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  joints_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
+  episode_pub_ = nh_.advertise<EpisodeInfo>("episode", 1, /*latch=*/true);
+  for (int i = 0; i < 2; ++i) {
+    contact_pub_[i] = nh_.advertise<TactileContact>(std::string(kSensorNames[i]) + "/contact", 10);
+  }
+  startEpisode(params_.seed, params_.height_offset);
+
+  command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
+  reset_srv_ = private_nh_.advertiseService("reset", &ContactSim::onReset, this);
+  if (params_.synchronous) {
+    step_srv_ = private_nh_.advertiseService("step", &ContactSim::onStep, this);
+  } else {
+    timer_ =
+        nh_.createWallTimer(ros::WallDuration(frame_period_ns_ * 1e-9), &ContactSim::onTimer, this);
+  }
+  publishFrame();
+  ROS_INFO(
+      "contact_sim: %s mode, scene %s, material %s (friction %.2f), physics %.0f Hz "
+      "(%d ticks per %.1f Hz frame), object '%s' %s",
+      params_.synchronous ? "synchronous" : "real-time", params_.scene.c_str(),
+      params_.material.c_str(), material.friction, config.physics.rate_hz, ticks_per_frame_,
+      params_.frame_rate, config.object.name.c_str(), config.object.mesh.c_str());
+}
+
+ros::Time ContactSim::frameStamp() const {
+  return time_base_ + (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
+}
+
+EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
+  const EpisodeStart start =
+      sim_->reset(static_cast<std::uint64_t>(seed),
+                  std::isnan(height_offset) ? std::nullopt : std::optional<double>(height_offset));
+  // Pad the settle to whole frames: every frame stays on the physics clock's grid.
+  const std::int64_t ticks = sim_->ticks();
+  sim_->step(static_cast<int>((ticks_per_frame_ - ticks % ticks_per_frame_) % ticks_per_frame_));
+  frame_ = sim_->ticks() / ticks_per_frame_;
+  if (!owns_clock_) {
+    // Wall-clock stamps: simulated time maps onto now (a reset's settling time is skipped).
+    time_base_ =
+        ros::Time::now() - (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
+  } else {
+    rosgraph_msgs::Clock clock;
+    clock.clock = frameStamp();
+    clock_pub_.publish(clock);
+  }
+  EpisodeInfo info;
+  info.header.stamp = frameStamp();
+  info.header.frame_id = "world";
+  info.episode = ++episode_;
+  info.object = sim_->config().object.name;
+  info.material = params_.material;
+  info.variant = static_cast<std::uint32_t>(params_.variant);
+  info.beta = beta_mm_;
+  info.seed = seed;
+  info.scenario = params_.scenario;
+  info.height_offset = start.height_offset_m;
+  episode_pub_.publish(info);
+  return info;
+}
+
+bool ContactSim::applyCommand(const GripperCommand& command) {
+  try {
+    if (command.mode == GripperCommand::ABSOLUTE) {
+      sim_->setOpening(command.opening);
+    } else if (command.mode == GripperCommand::DELTA) {
+      sim_->addOpening(command.opening);
+    } else {
+      throw Error("gripper command mode " + std::to_string(command.mode) +
+                  " is not valid; valid: 0 (ABSOLUTE), 1 (DELTA)");
+    }
+    return true;
+  } catch (const Error& e) {
+    ROS_WARN_THROTTLE(1.0, "contact_sim: command rejected, nothing changed: %s", e.what());
+    return false;
+  }
+}
+
+void ContactSim::onCommand(const GripperCommand::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  applyCommand(*msg);
+}
+
+bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (request.seed < 0) {
+    ROS_WARN("contact_sim: ~reset seed %ld rejected; valid: >= 0", static_cast<long>(request.seed));
+    return false;
+  }
+  try {
+    response.info = startEpisode(request.seed, request.height_offset);
+  } catch (const Error& e) {
+    ROS_WARN("contact_sim: ~reset rejected: %s", e.what());
+    return false;
+  }
+  publishFrame();
+  return true;
+}
+
+bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (request.frames < 1 || request.frames > 100000) {
+    ROS_WARN("contact_sim: ~step frames = %u rejected; valid: [1, 100000]", request.frames);
+    return false;
+  }
+  if (request.set_command && !applyCommand(request.command)) return false;
+  for (std::uint32_t i = 0; i < request.frames; ++i) advanceFrame();
+  response.stamp = frameStamp();
+  response.opening = sim_->opening();
+  response.dropped = sim_->dropped();
+  return true;
+}
+
+void ContactSim::onTimer(const ros::WallTimerEvent&) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  advanceFrame();
+}
+
+void ContactSim::advanceFrame() {
+  sim_->step(ticks_per_frame_);
+  ++frame_;
+  if (owns_clock_) {
+    rosgraph_msgs::Clock clock;
+    clock.clock = frameStamp();
+    clock_pub_.publish(clock);
+  }
+  publishFrame();
+}
+
+void ContactSim::publishFrame() {
+  const ros::Time stamp = frameStamp();
+  auto stamped = [&](const std::string& parent, const std::string& child,
+                     const Eigen::Isometry3d& pose) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = stamp;
+    t.header.frame_id = parent;
+    t.child_frame_id = child;
+    t.transform = ros_conversions::toTransformMsg(pose);
+    return t;
+  };
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  transforms.push_back(stamped("world", "gripper_base", sim_->baseInWorld()));
+  for (int i = 0; i < 2; ++i) {
+    const Finger finger = static_cast<Finger>(i);
+    transforms.push_back(stamped("gripper_base", kFingerFrames[i], sim_->fingerInBase(finger)));
+    transforms.push_back(stamped(kFingerFrames[i], kGelFrames[i], GripperSim::gelInFinger(finger)));
+  }
+  transforms.push_back(stamped("world", "object", sim_->objectInWorld()));
+  tf_.sendTransform(transforms);
+
+  sensor_msgs::JointState joints;
+  joints.header.stamp = stamp;
+  joints.name = {"finger_left_joint", "finger_right_joint"};
+  joints.position = {sim_->fingerPosition(), sim_->fingerPosition()};
+  joints_pub_.publish(joints);
+
+  for (int i = 0; i < 2; ++i) {
+    const GelContactState& state = sim_->contact(static_cast<Finger>(i));
+    // The patch costs a rasterization: skip it when nobody listens.
+    if (contact_pub_[i].getNumSubscribers() == 0) continue;
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = kGelFrames[i];
+    const ContactPatch patch = meters_[i]->measure(sim_->object().mesh, state.object_in_gel);
+    contact_pub_[i].publish(ros_conversions::toContactMsg(header, kSensorNames[i], state, patch));
+  }
+}
+
+}  // namespace norm2tex

@@ -1,0 +1,81 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/GripperCommand.h"
+#include "norm2tex/Reset.h"
+#include "norm2tex/Step.h"
+#include "norm2tex/sim/contact_patch.hpp"
+#include "norm2tex/sim/gripper_sim.hpp"
+
+namespace norm2tex {
+
+/// Validated private parameters of contact_sim (see README, "contact_sim").
+struct ContactSimParams {
+  bool synchronous = false;      ///< ~mode: "real_time" | "synchronous"
+  std::string scene;             ///< ~scene: scene yaml
+  std::string sensor;            ///< ~sensor: sensor yaml (gel size and thickness)
+  std::string material;          ///< ~material: config/materials/<material>.yaml gives the friction
+  std::string material_config;   ///< the yaml resolved from ~material
+  std::int64_t seed = 0;         ///< ~seed: seed of the first episode
+  double height_offset = 0;      ///< ~height_offset [m] of the first episode, NaN = random
+  double physics_rate = 1000.0;  ///< ~physics_rate [Hz], rounded to whole ticks per frame
+  double frame_rate = 60.0;      ///< ~frame_rate [Hz]: sensor frames (TF, contacts, clock)
+  int variant = 0;               ///< ~variant: texture variant, a label for EpisodeInfo
+  double beta = -1;              ///< ~beta [mm], label; < 0: the material's beta_mm
+  std::string scenario = "grasp";  ///< ~scenario: label
+};
+
+/// Reads and validates the private parameters; throws Error naming the parameter and its valid
+/// range (or the file) at fault.
+ContactSimParams readContactSimParams(const ros::NodeHandle& private_nh);
+
+/// The contact_sim node's work, shared by the node and the nodelet: owns a GripperSim and
+/// publishes every sensor frame over tf2, /joint_states, /digit_*/contact and /clock.
+class ContactSim {
+ public:
+  /// Throws Error (bad parameter, unreadable scene/mesh/material) before advertising anything.
+  ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+ private:
+  void onCommand(const GripperCommand::ConstPtr& msg);
+  bool onReset(Reset::Request& request, Reset::Response& response);
+  bool onStep(Step::Request& request, Step::Response& response);
+  void onTimer(const ros::WallTimerEvent& event);
+
+  /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
+  bool applyCommand(const GripperCommand& command);
+  EpisodeInfo startEpisode(std::int64_t seed, double height_offset);
+  /// Advances one sensor frame of physics and publishes it.
+  void advanceFrame();
+  void publishFrame();
+  ros::Time frameStamp() const;
+
+  ContactSimParams params_;
+  std::unique_ptr<GripperSim> sim_;
+  std::unique_ptr<ContactPatchMeter> meters_[2];
+  int ticks_per_frame_ = 17;
+  std::int64_t frame_period_ns_ = 0;
+  std::int64_t frame_ = 0;  ///< sensor frames since start (the simulated clock)
+  ros::Time time_base_;     ///< added to simulated time: 0 with use_sim_time, else wall
+  bool owns_clock_ = false;
+  double beta_mm_ = 0.0;
+  std::uint32_t episode_ = 0;
+
+  std::mutex mutex_;  // nodelet callbacks may run on several threads
+  ros::NodeHandle nh_, private_nh_;
+  tf2_ros::TransformBroadcaster tf_;
+  ros::Publisher clock_pub_, joints_pub_, episode_pub_, contact_pub_[2];
+  ros::Subscriber command_sub_;
+  ros::ServiceServer reset_srv_, step_srv_;
+  ros::WallTimer timer_;
+};
+
+}  // namespace norm2tex

@@ -1,0 +1,64 @@
+// Conversions between core types and ROS messages (no master needed).
+#include <gtest/gtest.h>
+
+#include "conversions.hpp"
+#include "norm2tex/common/error.hpp"
+
+namespace norm2tex {
+namespace {
+
+TEST(ConversionsTest, TransformRoundTripKeepsThePose) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(0.01, -0.2, 3.0);
+  const geometry_msgs::Transform msg = ros_conversions::toTransformMsg(pose);
+  EXPECT_DOUBLE_EQ(msg.translation.y, -0.2);
+  const double norm = std::sqrt(msg.rotation.x * msg.rotation.x + msg.rotation.y * msg.rotation.y +
+                                msg.rotation.z * msg.rotation.z + msg.rotation.w * msg.rotation.w);
+  EXPECT_NEAR(norm, 1.0, 1e-12);
+  EXPECT_TRUE(ros_conversions::fromTransformMsg(msg).isApprox(pose, 1e-12));
+}
+
+TEST(ConversionsTest, GelFrameRotationSurvivesTheMessage) {
+  // The left gel's rotation has a 180-degree component: quaternion round trips must keep it.
+  const Eigen::Isometry3d gel = GripperSim::gelInFinger(Finger::kLeft);
+  EXPECT_TRUE(
+      ros_conversions::fromTransformMsg(ros_conversions::toTransformMsg(gel)).isApprox(gel, 1e-12));
+}
+
+TEST(ConversionsTest, TimeIsExactToTheNanosecond) {
+  const ros::Time t = ros_conversions::toRosTime(16666667LL * 1000 + 3);
+  EXPECT_EQ(t.sec, 16u);
+  EXPECT_EQ(t.nsec, 666667003u);
+  EXPECT_EQ(t.toNSec(), 16666667003ull);
+  EXPECT_THROW(ros_conversions::toRosTime(-1), Error);
+}
+
+TEST(ConversionsTest, ContactMessageCarriesEveryField) {
+  GelContactState state;
+  state.in_contact = true;
+  state.normal_force_n = 12.5;
+  state.shear_force_n = Eigen::Vector3d(0.1, 0.49, 0.0);
+  state.penetration_m = 1e-3;
+  ContactPatch patch;
+  patch.area_m2 = 4.9e-4;
+  patch.centroid_m = Eigen::Vector2d(-0.001, 0.002);
+  std_msgs::Header header;
+  header.frame_id = "digit_left_gel";
+  header.stamp = ros::Time(5, 7);
+  const TactileContact msg = ros_conversions::toContactMsg(header, "digit_left", state, patch);
+  EXPECT_EQ(msg.header.frame_id, "digit_left_gel");
+  EXPECT_EQ(msg.header.stamp, ros::Time(5, 7));
+  EXPECT_EQ(msg.sensor, "digit_left");
+  EXPECT_TRUE(msg.in_contact);
+  EXPECT_DOUBLE_EQ(msg.normal_force, 12.5);
+  EXPECT_DOUBLE_EQ(msg.shear_force.y, 0.49);
+  EXPECT_DOUBLE_EQ(msg.max_indentation, 1e-3);
+  EXPECT_DOUBLE_EQ(msg.contact_area, 4.9e-4);
+  EXPECT_DOUBLE_EQ(msg.centroid.x, -0.001);
+  EXPECT_DOUBLE_EQ(msg.centroid.y, 0.002);
+}
+
+}  // namespace
+}  // namespace norm2tex
