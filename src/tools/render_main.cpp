@@ -13,12 +13,13 @@
 
 #include "cli_arguments.hpp"
 #include "contact_sheet.hpp"
-#include "norm2tex/texture/atlas_cache.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/image_io.hpp"
 #include "norm2tex/materials/material_texture.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
+#include "norm2tex/texture/atlas_cache.hpp"
 #include "package_paths.hpp"
 #include "quiet_stderr.hpp"
 
@@ -52,28 +53,14 @@ constexpr const char* kUsage =
     "          texture, then one row per normal map.\n";
 
 std::shared_ptr<const norm2tex::TexturedMesh> loadMesh(const std::string& spec, double scale) {
-  if (spec.rfind("sphere:", 0) == 0) {
-    std::istringstream text(spec.substr(7));
-    double radius_mm = 0;
-    if (!(text >> radius_mm) || !(radius_mm > 0)) {
-      throw norm2tex::cli::UsageError("--mesh sphere:<radius_mm>, got '" + spec + "'");
-    }
-    return std::make_shared<norm2tex::TexturedMesh>(
-        norm2tex::makeUvSphere(radius_mm * 1e-3, 96, 192));
+  const bool primitive = spec.rfind("sphere:", 0) == 0 || spec.rfind("box:", 0) == 0;
+  try {
+    return std::make_shared<norm2tex::TexturedMesh>(norm2tex::loadObjectMesh(spec, scale).mesh);
+  } catch (const norm2tex::Error& e) {
+    // A malformed primitive is a usage mistake (exit 2); a bad file is an input error (exit 1).
+    if (primitive) throw norm2tex::cli::UsageError(std::string("--mesh: ") + e.what());
+    throw;
   }
-  if (spec.rfind("box:", 0) == 0) {
-    double x = 0, y = 0, z = 0;
-    char sep1 = 0, sep2 = 0;
-    std::istringstream sizes(spec.substr(4));
-    if (!(sizes >> x >> sep1 >> y >> sep2 >> z) || sep1 != 'x' || sep2 != 'x') {
-      throw norm2tex::cli::UsageError("--mesh box:<x_mm>x<y_mm>x<z_mm>, got '" + spec + "'");
-    }
-    return std::make_shared<norm2tex::TexturedMesh>(
-        norm2tex::makeBox(Eigen::Vector3d(x, y, z) * 1e-3, 0.02));
-  }
-  norm2tex::MeshLoadOptions options;
-  options.scale = scale;
-  return std::make_shared<norm2tex::TexturedMesh>(norm2tex::TexturedMesh::load(spec, options));
 }
 
 Eigen::Isometry3d parsePose(const std::string& text, double press_mm) {

@@ -283,6 +283,18 @@ TEST(GripperSimTest, MeshObjectsUseTheirConvexHull) {
   config.object.mass_kg = 0.02;
   GripperSim sim(config);
   EXPECT_EQ(sim.object().shape, ObjectMesh::Shape::kMesh);
+  // A box given as a file collides as an exact box; four of its corners (a tetrahedron) do not.
+  std::ofstream(dir.path("box.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+                                        "v 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+                                        "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\n"
+                                        "f 1 5 7 3\nf 2 4 8 6\n";
+  std::ofstream(dir.path("tetra.obj")) << "v 0 0 0\nv 1 1 0\nv 1 0 1\nv 0 1 1\n"
+                                          "f 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n";
+  EXPECT_EQ(loadObjectMesh(dir.path("box.obj")).shape, ObjectMesh::Shape::kBox);
+  EXPECT_EQ(loadObjectMesh(dir.path("tetra.obj")).shape, ObjectMesh::Shape::kMesh);
+  EXPECT_EQ(loadObjectMesh("box:30x20x10").shape, ObjectMesh::Shape::kBox);
+  test::expectError([] { loadObjectMesh("box:30x20"); }, {"box:30x20", "box:<x_mm>x<y_mm>x<z_mm>"});
+  test::expectError([] { loadObjectMesh("sphere:-1"); }, {"sphere:-1", "radius > 0"});
   sim.reset(1, 0.0);
   EXPECT_TRUE(sim.contact(Finger::kLeft).in_contact);
   EXPECT_TRUE(sim.contact(Finger::kRight).in_contact);

@@ -196,7 +196,8 @@ TEST(Synchronous, StepsAdvanceClockAndTfByExactlyTheirFramesAndNothingElse) {
         << "/clock or TF never reached the step's stamp";
     EXPECT_FALSE(srv.response.dropped);
   }
-  // Between calls nothing moves: no new clock tick in 0.3 s of wall time.
+  // Between calls nothing moves: no new clock tick in 0.3 s of wall time. (This waits for an
+  // absence, which no condition can signal; nothing is synchronised by it.)
   const int ticks = l.clock_count;
   ros::WallDuration(0.3).sleep();
   ros::spinOnce();

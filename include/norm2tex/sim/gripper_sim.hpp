@@ -117,6 +117,10 @@ class GripperSim {
 
   void buildWorld(double object_height_m);
   void moveFingers(double dt);
+  /// Calls visit(btManifoldPoint&, bool gel_is_body_a) for every contact point between gel
+  /// `gel_index` and the object.
+  template <typename Visit>
+  void forEachGelPoint(int gel_index, Visit visit) const;
   void updateGelStiffness();
   void measureContacts(double dt);
   double objectWidthM() const;

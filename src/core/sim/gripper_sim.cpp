@@ -269,75 +269,66 @@ void GripperSim::moveFingers(double dt) {
   }
 }
 
-void GripperSim::updateGelStiffness() {
-  // Secant stiffness of the law at the current penetration, shared among the contact points
-  // in proportion to their depth: sum_i k d_i = F(d_max).
+template <typename Visit>
+void GripperSim::forEachGelPoint(int gel_index, Visit visit) const {
   btDispatcher& dispatcher = world_->dispatcher;
-  for (int i = 0; i < 2; ++i) {
-    btRigidBody* gel = world_->gels[i].get();
-    double deepest = 0.0, sum = 0.0;
-    std::vector<btPersistentManifold*> manifolds;
-    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
-      btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
-      if ((manifold->getBody0() == gel && manifold->getBody1() == world_->object.get()) ||
-          (manifold->getBody1() == gel && manifold->getBody0() == world_->object.get())) {
-        manifolds.push_back(manifold);
-        for (int c = 0; c < manifold->getNumContacts(); ++c) {
-          const double d = -manifold->getContactPoint(c).getDistance();
-          if (d > 0.0) {
-            deepest = std::max(deepest, d);
-            sum += d;
-          }
-        }
-      }
-    }
-    const double k =
-        sum > 0.0 ? config_.gel_law.force(deepest) / sum : config_.gel_law.secantStiffness(0.0);
-    gel->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
-    // Points kept by a friction anchor are not re-created by collision detection: set them too.
-    const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
-    for (btPersistentManifold* manifold : manifolds) {
-      for (int c = 0; c < manifold->getNumContacts(); ++c) {
-        btManifoldPoint& point = manifold->getContactPoint(c);
-        point.m_combinedContactStiffness1 = k;
-        point.m_combinedContactDamping1 = damping;
-        point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
-      }
+  const btCollisionObject* gel = world_->gels[gel_index].get();
+  const btCollisionObject* object = world_->object.get();
+  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+    btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+    const bool gel_is_a = manifold->getBody0() == gel && manifold->getBody1() == object;
+    if (!gel_is_a && !(manifold->getBody1() == gel && manifold->getBody0() == object)) continue;
+    for (int c = 0; c < manifold->getNumContacts(); ++c) {
+      visit(manifold->getContactPoint(c), gel_is_a);
     }
   }
 }
 
+void GripperSim::updateGelStiffness() {
+  // Secant stiffness of the law at the current penetration, shared among the contact points
+  // in proportion to their depth: sum_i k d_i = F(d_max).
+  const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
+  for (int i = 0; i < 2; ++i) {
+    double deepest = 0.0, sum = 0.0;
+    forEachGelPoint(i, [&](const btManifoldPoint& point, bool) {
+      const double d = -point.getDistance();
+      if (d > 0.0) {
+        deepest = std::max(deepest, d);
+        sum += d;
+      }
+    });
+    const double k =
+        sum > 0.0 ? config_.gel_law.force(deepest) / sum : config_.gel_law.secantStiffness(0.0);
+    world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
+    // Points kept by a friction anchor are not re-created by collision detection: set them too.
+    forEachGelPoint(i, [&](btManifoldPoint& point, bool) {
+      point.m_combinedContactStiffness1 = k;
+      point.m_combinedContactDamping1 = damping;
+      point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+    });
+  }
+}
+
 void GripperSim::measureContacts(double dt) {
-  btDispatcher& dispatcher = world_->dispatcher;
   const Eigen::Isometry3d object_in_world = objectInWorld();
   for (int i = 0; i < 2; ++i) {
-    const btRigidBody* gel = world_->gels[i].get();
     const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
     GelContactState& state = contacts_[i];
     state = GelContactState{};
     state.object_in_gel = gel_in_world.inverse() * object_in_world;
     Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
-    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
-      const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
-      const bool gel_is_a =
-          manifold->getBody0() == gel && manifold->getBody1() == world_->object.get();
-      const bool gel_is_b =
-          manifold->getBody1() == gel && manifold->getBody0() == world_->object.get();
-      if (!gel_is_a && !gel_is_b) continue;
-      for (int c = 0; c < manifold->getNumContacts(); ++c) {
-        const btManifoldPoint& point = manifold->getContactPoint(c);
-        state.penetration_m =
-            std::max(state.penetration_m, -static_cast<double>(point.getDistance()));
-        state.normal_force_n += point.getAppliedImpulse() / dt;
-        // Friction impulses act on body A along the lateral directions; the gel feels the
-        // object's reaction.
-        const Eigen::Vector3d on_a =
-            (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
-             toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
-            dt;
-        shear_world += gel_is_a ? on_a : Eigen::Vector3d(-on_a);
-      }
-    }
+    forEachGelPoint(i, [&](const btManifoldPoint& point, bool gel_is_a) {
+      state.penetration_m =
+          std::max(state.penetration_m, -static_cast<double>(point.getDistance()));
+      state.normal_force_n += point.getAppliedImpulse() / dt;
+      // Friction impulses act on body A along the lateral directions; the gel feels the
+      // object's reaction.
+      const Eigen::Vector3d on_a =
+          (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
+           toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
+          dt;
+      shear_world += gel_is_a ? on_a : Eigen::Vector3d(-on_a);
+    });
     state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
     state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
     state.shear_force_n.z() = 0.0;
