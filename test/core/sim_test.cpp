@@ -245,7 +245,7 @@ TEST(GripperSimConfigTest, LoadsTheShippedScenesAndRejectsBadOnes) {
   test::expectError([&] { loadGripperSimConfig(write("physics: {rate_hz: 10}\n")); },
                     {"physics.rate_hz", "[100, 100000]"});
   test::expectError([&] { loadGripperSimConfig(write("object: {collision: hacd}\n")); },
-                    {"object.collision", "auto, box, hull"});
+                    {"object.collision", "auto, box, hull, decomposition"});
   test::expectError([&] { loadGripperSimConfig(write("gel: {law: [[0.1, 1], [0.05, 2]]}\n")); },
                     {"scene.yaml", "gel.law"});
   test::expectError([&] { loadGripperSimConfig(dir.path("missing.yaml")); }, {"missing.yaml"});
@@ -305,6 +305,49 @@ TEST(GripperSimTest, MeshObjectsUseTheirConvexHull) {
   const Eigen::Isometry3d before = sim.objectInWorld();
   sim.step(3000);
   EXPECT_LT((sim.objectInWorld().translation() - before.translation()).norm(), 0.1e-3);
+}
+
+TEST(GripperSimTest, ConcaveObjectsCanCollideAsConvexParts) {
+  // A U-shaped block (24 mm across its outer faces, a 12 x 20 mm notch from below), 20 mm deep:
+  // its decomposition has several convex parts, and it is held like any other object.
+  test::ScratchDirectory dir;
+  {
+    const double yz[10][2] = {{-12, -15}, {-6, -15}, {-6, 5}, {6, 5},   {6, -15},
+                              {12, -15},  {12, 15},  {6, 15}, {-6, 15}, {-12, 15}};
+    std::ofstream obj(dir.path("u.obj"));
+    for (double x : {-10.0, 10.0}) {
+      for (const auto& p : yz) obj << "v " << x << " " << p[0] << " " << p[1] << "\n";
+    }
+    const int caps[8][3] = {{0, 1, 2}, {0, 2, 9}, {2, 8, 9}, {2, 3, 7},
+                            {2, 7, 8}, {4, 5, 3}, {3, 5, 6}, {3, 6, 7}};
+    for (const auto& t : caps) {
+      obj << "f " << t[0] + 1 << " " << t[2] + 1 << " " << t[1] + 1 << "\n";     // x = -10
+      obj << "f " << t[0] + 11 << " " << t[1] + 11 << " " << t[2] + 11 << "\n";  // x = +10
+    }
+    for (int i = 0; i < 10; ++i) {
+      const int a = i + 1, b = (i + 1) % 10 + 1;
+      obj << "f " << a << " " << b << " " << b + 10 << "\nf " << a << " " << b + 10 << " " << a + 10
+          << "\n";
+    }
+  }
+  GripperSimConfig config = cubeConfig();
+  config.object.mesh = dir.path("u.obj");
+  config.object.scale = 0.001;
+  config.object.mass_kg = 0.05;
+  config.object.collision = "hull";
+  EXPECT_EQ(GripperSim(config).collisionPartCount(), 1);
+  config.object.collision = "decomposition";
+  GripperSim sim(config);
+  EXPECT_GE(sim.collisionPartCount(), 2);
+  sim.reset(1, 0.0);
+  for (Finger finger : {Finger::kLeft, Finger::kRight}) {
+    EXPECT_TRUE(sim.contact(finger).in_contact);
+    EXPECT_NEAR(sim.contact(finger).penetration_m, 1e-3, 0.05e-3);
+  }
+  const Eigen::Isometry3d before = sim.objectInWorld();
+  sim.step(3000);
+  EXPECT_LT((sim.objectInWorld().translation() - before.translation()).norm(), 0.1e-3);
+  EXPECT_FALSE(sim.dropped());
 }
 
 TEST(ContactPatchTest, SphereContactGrowsWithTheSqueezeAsGeometryPredicts) {

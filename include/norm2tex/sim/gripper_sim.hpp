@@ -4,11 +4,14 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <Eigen/Geometry>
 
 #include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
+
+class btCollisionShape;
 
 namespace norm2tex {
 
@@ -111,6 +114,8 @@ class GripperSim {
 
   const GripperSimConfig& config() const { return config_; }
   const ObjectMesh& object() const { return object_; }
+  /// Convex pieces the object collides as: 1 for a box or a hull, more for a decomposition.
+  int collisionPartCount() const;
 
  private:
   struct World;  // the Bullet objects
@@ -129,6 +134,8 @@ class GripperSim {
   ObjectMesh object_;
   /// Object frame in the collision body's frame (the body sits at the bounds' centre).
   Eigen::Isometry3d object_in_body_ = Eigen::Isometry3d::Identity();
+  /// The object's collision shape is back(); any shapes before it are its convex parts.
+  std::vector<std::unique_ptr<btCollisionShape>> object_shapes_;
   std::unique_ptr<World> world_;
   std::array<GelContactState, 2> contacts_;
   double command_ = 1.0;

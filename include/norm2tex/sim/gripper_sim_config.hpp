@@ -28,7 +28,9 @@ struct ObjectOptions {
   double scale = 1.0;     ///< mesh file units to metres (0.001 for millimetres)
   double mass_kg = 0.10;  ///< the paper's cube: ~30 mm of PLA, 100 g with its insert
   /// "auto" (an exact box if the mesh is one, else the convex hull of its vertices), "box"
-  /// (its bounding box), "hull".
+  /// (its bounding box), "hull", or "decomposition" (opt-in for concave objects: HACD convex
+  /// parts, computed once at construction; against a flat gel a concave object touches only
+  /// its hull until the gel reaches into a hollow, so "hull" is exact for most grasps).
   std::string collision = "auto";
   double friction = 0.5;  ///< Coulomb coefficient against the gel (from the material config)
   std::string material = "wood";  ///< label only: the material the friction came from

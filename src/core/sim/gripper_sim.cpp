@@ -10,6 +10,7 @@
 #include <BulletCollision/CollisionShapes/btShapeHull.h>
 
 #include "norm2tex/common/error.hpp"
+#include "sim/convex_decomposition.hpp"
 
 namespace norm2tex {
 namespace {
@@ -54,7 +55,6 @@ struct GripperSim::World {
 
   std::unique_ptr<btCollisionShape> floor_shape;
   std::unique_ptr<btCollisionShape> gel_shape;
-  std::unique_ptr<btCollisionShape> object_shape;
   std::unique_ptr<btRigidBody> floor;
   std::array<std::unique_ptr<btRigidBody>, 2> gels;
   std::unique_ptr<btRigidBody> object;
@@ -70,20 +70,24 @@ struct GripperSim::World {
 
 namespace {
 
-std::unique_ptr<btCollisionShape> makeObjectShape(const ObjectMesh& object,
-                                                  const std::string& collision,
-                                                  const Eigen::Vector3d& centre) {
+// The object's collision shape is the last element; any before it are its parts.
+std::vector<std::unique_ptr<btCollisionShape>> makeObjectShapes(const ObjectMesh& object,
+                                                                const std::string& collision,
+                                                                const Eigen::Vector3d& centre) {
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
   const Eigen::Vector3d half = object.mesh.bounds().sizes().cast<double>() / 2.0;
   if (collision == "box" || (collision == "auto" && object.shape == ObjectMesh::Shape::kBox)) {
     auto box = std::make_unique<btBoxShape>(toBt(half));
     box->setMargin(std::min(kBoxMargin, 0.25 * half.minCoeff()));
-    return box;
+    shapes.push_back(std::move(box));
+    return shapes;
   }
+  if (collision == "decomposition") return decomposeConvex(object.mesh, centre, kHullMargin);
   // Spheres take their mesh's hull too (within 5 um of the sphere at 96 x 192): Bullet's
   // sphere-box contact is a single point that did not hold a pinched ball (it slid 7 mm
   // under its own weight at 2.6 N of grip), while the polyhedral hull holds it still.
-  // Convex hull of the render mesh's vertices about the body origin, reduced to at most a
-  // few hundred vertices (btShapeHull) so contact generation stays cheap for big meshes.
+  // Convex hull of the render mesh's vertices about the body origin, reduced by btShapeHull
+  // so contact generation stays cheap for big meshes.
   btConvexHullShape full;
   for (const Eigen::Vector3f& v : object.mesh.vertices()) {
     full.addPoint(toBt(v.cast<double>() - centre), false);
@@ -93,11 +97,13 @@ std::unique_ptr<btCollisionShape> makeObjectShape(const ObjectMesh& object,
   btShapeHull reducer(&full);
   reducer.buildHull(0.0);
   auto hull = std::make_unique<btConvexHullShape>();
-  for (int i = 0; i < reducer.numVertices(); ++i)
+  for (int i = 0; i < reducer.numVertices(); ++i) {
     hull->addPoint(reducer.getVertexPointer()[i], false);
+  }
   hull->recalcLocalAabb();
   hull->setMargin(kHullMargin);
-  return hull;
+  shapes.push_back(std::move(hull));
+  return shapes;
 }
 
 }  // namespace
@@ -107,6 +113,8 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   object_ = loadObjectMesh(config_.object.mesh, config_.object.scale);
   const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
   object_in_body_ = Eigen::Translation3d(-centre);
+  // Built once: resets rebuild the world but reuse the (stateless) shape.
+  object_shapes_ = makeObjectShapes(object_, config_.object.collision, centre);
   if (objectWidthM() + 2 * kSeatClearance > config_.gripper.max_gap_m) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
@@ -120,6 +128,10 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
 }
 
 GripperSim::~GripperSim() = default;
+
+int GripperSim::collisionPartCount() const {
+  return std::max<int>(1, static_cast<int>(object_shapes_.size()) - 1);
+}
 
 double GripperSim::objectWidthM() const {
   return static_cast<double>(object_.mesh.bounds().sizes().y());
@@ -226,12 +238,10 @@ void GripperSim::buildWorld(double object_height_m) {
   }
 
   // Object: dynamic, its body at its bounds' centre.
-  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
-  world_->object_shape = makeObjectShape(object_, config_.object.collision, centre);
+  btCollisionShape* shape = object_shapes_.back().get();
   btVector3 inertia(0, 0, 0);
-  world_->object_shape->calculateLocalInertia(config_.object.mass_kg, inertia);
-  btRigidBody::btRigidBodyConstructionInfo info(config_.object.mass_kg, nullptr,
-                                                world_->object_shape.get(), inertia);
+  shape->calculateLocalInertia(config_.object.mass_kg, inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(config_.object.mass_kg, nullptr, shape, inertia);
   info.m_friction = 1.0;
   info.m_restitution = 0;
   world_->object = std::make_unique<btRigidBody>(info);

@@ -68,8 +68,9 @@ void validate(const GripperSimConfig& c) {
   requireParameter(o.scale > 0.0 && o.scale <= 1000.0, "object.scale", o.scale, "(0, 1000]");
   requireParameter(o.mass_kg > 0.0 && o.mass_kg <= 100.0, "object.mass_kg", o.mass_kg,
                    "(0, 100] kg");
-  requireParameter(o.collision == "auto" || o.collision == "box" || o.collision == "hull",
-                   "object.collision", o.collision, "auto, box, hull");
+  requireParameter(o.collision == "auto" || o.collision == "box" || o.collision == "hull" ||
+                       o.collision == "decomposition",
+                   "object.collision", o.collision, "auto, box, hull, decomposition");
   requireParameter(o.friction >= 0.0 && o.friction <= 2.0, "object.friction", o.friction, "[0, 2]");
   const PhysicsOptions& p = c.physics;
   requireParameter(p.rate_hz >= 100.0 && p.rate_hz <= 100000.0, "physics.rate_hz", p.rate_hz,
