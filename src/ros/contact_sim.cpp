@@ -5,10 +5,14 @@
 #include <sstream>
 
 #include <ros/package.h>
+#include <chrono>
+
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "conversions.hpp"
+#include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
@@ -78,6 +82,16 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   if (p.variant < 0) badParameter("variant", text(p.variant), ">= 0");
   pnh.param("beta", p.beta, -1.0);
   pnh.param<std::string>("scenario", p.scenario, p.scenario);
+  pnh.param("renderers", p.renderers, p.renderers);
+  for (const std::string& name : p.renderers) {
+    if (name.empty() || name.find(' ') != std::string::npos) {
+      badParameter("renderers", "['" + name + "', ...]", "sensor names such as digit_left");
+    }
+  }
+  pnh.param("render_timeout", p.render_timeout, p.render_timeout);
+  if (!(p.render_timeout > 0.0 && p.render_timeout <= 600.0)) {
+    badParameter("render_timeout", text(p.render_timeout), "(0, 600] s");
+  }
   return p;
 }
 
@@ -106,7 +120,9 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   owns_clock_ = use_sim_time;
 
+  tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  frame_pub_ = private_nh_.advertise<SimFrame>("frame", 100);
   joints_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   episode_pub_ = nh_.advertise<EpisodeInfo>("episode", 1, /*latch=*/true);
   for (int i = 0; i < 2; ++i) {
@@ -114,6 +130,16 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   startEpisode(params_.seed, params_.height_offset);
 
+  if (params_.synchronous && !params_.renderers.empty()) {
+    ros::NodeHandle ack_nh(nh_);
+    ack_nh.setCallbackQueue(&ack_queue_);
+    for (const std::string& sensor : params_.renderers) {
+      ack_subs_.push_back(
+          ack_nh.subscribe(sensor + "/rendered", 100, &ContactSim::onRendered, this));
+    }
+    ack_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &ack_queue_);
+    ack_spinner_->start();
+  }
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
   reset_srv_ = private_nh_.advertiseService("reset", &ContactSim::onReset, this);
   if (params_.synchronous) {
@@ -122,7 +148,9 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     timer_ =
         nh_.createWallTimer(ros::WallDuration(frame_period_ns_ * 1e-9), &ContactSim::onTimer, this);
   }
-  publishFrame();
+  // Synchronous renderers get their first frame with the first step (or reset); publishing one
+  // now would wait for renderers that may not have started yet.
+  if (!params_.synchronous || params_.renderers.empty()) publishFrame();
   ROS_INFO(
       "contact_sim: %s mode, scene %s, material %s (friction %.2f), physics %.0f Hz "
       "(%d ticks per %.1f Hz frame), object '%s' %s",
@@ -197,11 +225,11 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
   }
   try {
     response.info = startEpisode(request.seed, request.height_offset);
+    publishFrame();
   } catch (const Error& e) {
-    ROS_WARN("contact_sim: ~reset rejected: %s", e.what());
+    ROS_WARN("contact_sim: ~reset failed: %s", e.what());
     return false;
   }
-  publishFrame();
   return true;
 }
 
@@ -212,7 +240,17 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
     return false;
   }
   if (request.set_command && !applyCommand(request.command)) return false;
-  for (std::uint32_t i = 0; i < request.frames; ++i) advanceFrame();
+  response.missing_images = 0;
+  try {
+    for (std::uint32_t i = 0; i < request.frames; ++i) {
+      sim_->step(ticks_per_frame_);
+      ++frame_;
+      response.missing_images += publishFrame();
+    }
+  } catch (const Error& e) {
+    ROS_ERROR("contact_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
+    return false;
+  }
   response.stamp = frameStamp();
   response.opening = sim_->opening();
   response.dropped = sim_->dropped();
@@ -227,16 +265,50 @@ void ContactSim::onTimer(const ros::WallTimerEvent&) {
 void ContactSim::advanceFrame() {
   sim_->step(ticks_per_frame_);
   ++frame_;
-  if (owns_clock_) {
-    rosgraph_msgs::Clock clock;
-    clock.clock = frameStamp();
-    clock_pub_.publish(clock);
-  }
   publishFrame();
 }
 
-void ContactSim::publishFrame() {
+void ContactSim::onRendered(const FrameRendered::ConstPtr& msg) {
+  {
+    std::lock_guard<std::mutex> lock(ack_mutex_);
+    last_ack_[msg->sensor] = *msg;
+  }
+  ack_cv_.notify_all();
+}
+
+void ContactSim::waitForRenderers() {
+  // A renderer that is not yet connected would miss the frame (or its TF) and never answer.
+  const std::size_t needed = params_.renderers.size();
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.render_timeout);
+  auto connected = [&] {
+    if (frame_pub_.getNumSubscribers() < needed || tf_pub_.getNumSubscribers() < needed) {
+      return false;
+    }
+    for (const ros::Subscriber& sub : ack_subs_) {
+      if (sub.getNumPublishers() == 0) return false;
+    }
+    return true;
+  };
+  while (!connected()) {
+    if (ros::WallTime::now() > deadline || !ros::ok()) {
+      std::string names;
+      for (const std::string& name : params_.renderers) names += " " + name;
+      throw Error("renderers" + names + " not connected within ~render_timeout = " +
+                  text(params_.render_timeout) + " s (are the tactile_renderer nodes running?)");
+    }
+    ros::WallDuration(0.001).sleep();
+  }
+}
+
+std::uint32_t ContactSim::publishFrame() {
   const ros::Time stamp = frameStamp();
+  const bool acknowledge = params_.synchronous && !params_.renderers.empty();
+  if (acknowledge) waitForRenderers();
+  if (owns_clock_) {
+    rosgraph_msgs::Clock clock;
+    clock.clock = stamp;
+    clock_pub_.publish(clock);
+  }
   auto stamped = [&](const std::string& parent, const std::string& child,
                      const Eigen::Isometry3d& pose) {
     geometry_msgs::TransformStamped t;
@@ -254,7 +326,9 @@ void ContactSim::publishFrame() {
     transforms.push_back(stamped(kFingerFrames[i], kGelFrames[i], GripperSim::gelInFinger(finger)));
   }
   transforms.push_back(stamped("world", "object", sim_->objectInWorld()));
-  tf_.sendTransform(transforms);
+  tf2_msgs::TFMessage tf;
+  tf.transforms = std::move(transforms);
+  tf_pub_.publish(tf);
 
   sensor_msgs::JointState joints;
   joints.header.stamp = stamp;
@@ -272,6 +346,48 @@ void ContactSim::publishFrame() {
     const ContactPatch patch = meters_[i]->measure(sim_->object().mesh, state.object_in_gel);
     contact_pub_[i].publish(ros_conversions::toContactMsg(header, kSensorNames[i], state, patch));
   }
+
+  SimFrame frame;
+  frame.header.stamp = stamp;
+  frame.header.frame_id = "world";
+  frame.frame = static_cast<std::uint64_t>(frame_);
+  frame.episode = episode_;
+  frame.acknowledge = acknowledge;
+  frame_pub_.publish(frame);
+  if (!acknowledge) return 0;
+
+  // Lock-step: every renderer answers this frame before the next one is simulated.
+  std::unique_lock<std::mutex> lock(ack_mutex_);
+  auto answered = [&](const std::string& sensor) {
+    const auto it = last_ack_.find(sensor);
+    return it != last_ack_.end() && it->second.frame == frame.frame &&
+           it->second.header.stamp == stamp;
+  };
+  const bool all =
+      ack_cv_.wait_for(lock, std::chrono::duration<double>(params_.render_timeout), [&] {
+        for (const std::string& sensor : params_.renderers) {
+          if (!answered(sensor)) return false;
+        }
+        return true;
+      });
+  if (!all) {
+    std::string missing;
+    for (const std::string& sensor : params_.renderers) {
+      if (!answered(sensor)) missing += " " + sensor;
+    }
+    throw Error("no answer from" + missing +
+                " within ~render_timeout = " + text(params_.render_timeout) + " s");
+  }
+  std::uint32_t missing_images = 0;
+  for (const std::string& sensor : params_.renderers) {
+    const FrameRendered& ack = last_ack_.at(sensor);
+    if (!ack.published) {
+      ++missing_images;
+      ROS_WARN("contact_sim: %s published no image for frame %lu: %s", sensor.c_str(),
+               static_cast<unsigned long>(frame.frame), ack.reason.c_str());
+    }
+  }
+  return missing_images;
 }
 
 }  // namespace norm2tex

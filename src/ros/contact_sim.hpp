@@ -1,14 +1,18 @@
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/FrameRendered.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
@@ -31,6 +35,10 @@ struct ContactSimParams {
   int variant = 0;               ///< ~variant: texture variant, a label for EpisodeInfo
   double beta = -1;              ///< ~beta [mm], label; < 0: the material's beta_mm
   std::string scenario = "grasp";  ///< ~scenario: label
+  /// ~renderers: sensors whose FrameRendered each synchronous frame waits for (e.g.
+  /// [digit_left, digit_right]); empty: none.
+  std::vector<std::string> renderers;
+  double render_timeout = 5.0;  ///< ~render_timeout [s of wall time] for each FrameRendered
 };
 
 /// Reads and validates the private parameters; throws Error naming the parameter and its valid
@@ -49,13 +57,18 @@ class ContactSim {
   bool onReset(Reset::Request& request, Reset::Response& response);
   bool onStep(Step::Request& request, Step::Response& response);
   void onTimer(const ros::WallTimerEvent& event);
+  void onRendered(const FrameRendered::ConstPtr& msg);
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
   bool applyCommand(const GripperCommand& command);
   EpisodeInfo startEpisode(std::int64_t seed, double height_offset);
   /// Advances one sensor frame of physics and publishes it.
   void advanceFrame();
-  void publishFrame();
+  /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.
+  /// Returns how many of them published no image; throws Error when one did not answer in time.
+  std::uint32_t publishFrame();
+  /// Waits (wall-clock deadline) until every renderer listens to the frames and TF.
+  void waitForRenderers();
   ros::Time frameStamp() const;
 
   ContactSimParams params_;
@@ -71,11 +84,19 @@ class ContactSim {
 
   std::mutex mutex_;  // nodelet callbacks may run on several threads
   ros::NodeHandle nh_, private_nh_;
-  tf2_ros::TransformBroadcaster tf_;
-  ros::Publisher clock_pub_, joints_pub_, episode_pub_, contact_pub_[2];
+  ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, frame_pub_, contact_pub_[2];
   ros::Subscriber command_sub_;
   ros::ServiceServer reset_srv_, step_srv_;
   ros::WallTimer timer_;
+
+  // FrameRendered answers arrive on their own queue and thread: ~step blocks the main queue
+  // while it waits for them.
+  ros::CallbackQueue ack_queue_;
+  std::unique_ptr<ros::AsyncSpinner> ack_spinner_;
+  std::vector<ros::Subscriber> ack_subs_;
+  std::mutex ack_mutex_;
+  std::condition_variable ack_cv_;
+  std::map<std::string, FrameRendered> last_ack_;  ///< latest answer of each renderer
 };
 
 }  // namespace norm2tex

@@ -1,6 +1,9 @@
 #include "conversions.hpp"
 
+#include <cstring>
 #include <limits>
+
+#include <boost/make_shared.hpp>
 
 #include "norm2tex/common/error.hpp"
 
@@ -56,6 +59,47 @@ TactileContact toContactMsg(const std_msgs::Header& header, const std::string& s
   msg.centroid.y = patch.centroid_m.y();
   msg.centroid.z = 0.0;
   return msg;
+}
+
+sensor_msgs::ImagePtr toImageMsg(const std_msgs::Header& header, const cv::Mat& image) {
+  auto msg = boost::make_shared<sensor_msgs::Image>();
+  msg->header = header;
+  switch (image.type()) {
+    case CV_8UC3:
+      msg->encoding = "bgr8";
+      break;
+    case CV_8UC1:
+      msg->encoding = "mono8";
+      break;
+    case CV_32FC1:
+      msg->encoding = "32FC1";
+      break;
+    default:
+      throw Error("image type " + std::to_string(image.type()) +
+                  " has no sensor_msgs encoding here; valid: CV_8UC3, CV_8UC1, CV_32FC1");
+  }
+  msg->height = static_cast<std::uint32_t>(image.rows);
+  msg->width = static_cast<std::uint32_t>(image.cols);
+  msg->is_bigendian = false;
+  msg->step = static_cast<std::uint32_t>(image.cols * image.elemSize());
+  msg->data.resize(static_cast<std::size_t>(msg->step) * image.rows);
+  for (int r = 0; r < image.rows; ++r) {
+    std::memcpy(&msg->data[static_cast<std::size_t>(r) * msg->step], image.ptr(r), msg->step);
+  }
+  return msg;
+}
+
+sensor_msgs::CameraInfo toCameraInfo(const std_msgs::Header& header, const SensorModel& model) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.height = static_cast<std::uint32_t>(model.rows);
+  info.width = static_cast<std::uint32_t>(model.cols);
+  info.distortion_model = "plumb_bob";
+  info.D = {0.0, 0.0, 0.0, 0.0, 0.0};
+  info.K = {model.fx, 0.0, model.cx, 0.0, model.fy, model.cy, 0.0, 0.0, 1.0};
+  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  info.P = {model.fx, 0.0, model.cx, 0.0, 0.0, model.fy, model.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  return info;
 }
 
 }  // namespace ros_conversions

@@ -6,9 +6,13 @@
 
 #include <geometry_msgs/Transform.h>
 #include <ros/time.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 
 #include "norm2tex/TactileContact.h"
+#include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 
@@ -26,6 +30,13 @@ ros::Time toRosTime(std::int64_t nanoseconds);
 /// from the rendered contact patch. `header` carries the frame's stamp and the gel frame.
 TactileContact toContactMsg(const std_msgs::Header& header, const std::string& sensor,
                             const GelContactState& state, const ContactPatch& patch);
+
+/// An image message holding a copy of `image`: CV_8UC3 as "bgr8", CV_8UC1 as "mono8", CV_32FC1
+/// as "32FC1"; throws Error for any other type.
+sensor_msgs::ImagePtr toImageMsg(const std_msgs::Header& header, const cv::Mat& image);
+
+/// The sensor's pinhole intrinsics (no distortion), as a DIGIT driver would publish them.
+sensor_msgs::CameraInfo toCameraInfo(const std_msgs::Header& header, const SensorModel& model);
 
 }  // namespace ros_conversions
 }  // namespace norm2tex

@@ -15,11 +15,12 @@
 #include "contact_sheet.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/image_io.hpp"
+#include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/material_texture.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
-#include "norm2tex/texture/atlas_cache.hpp"
 #include "package_paths.hpp"
 #include "quiet_stderr.hpp"
 
@@ -85,13 +86,13 @@ Eigen::Isometry3d parsePose(const std::string& text, double press_mm) {
   return pose;
 }
 
-std::shared_ptr<const norm2tex::HeightAtlas> bakeCached(const std::string& normal_map) {
-  const norm2tex::AtlasCache cache(norm2tex::AtlasCache::defaultDirectory());
-  norm2tex::AtlasCache::Result result = cache.loadOrBake(normal_map, "", {});
-  if (!result.store_error.empty()) {
-    std::fprintf(stderr, "norm2tex_render: warning: %s\n", result.store_error.c_str());
+std::shared_ptr<const norm2tex::HeightAtlas> loadTexture(norm2tex::TextureSource source,
+                                                         const norm2tex::TexturedMesh& mesh) {
+  const norm2tex::ObjectTexture texture = norm2tex::loadTextureFile(source, mesh);
+  if (!texture.warning.empty()) {
+    std::fprintf(stderr, "norm2tex_render: warning: %s\n", texture.warning.c_str());
   }
-  return std::make_shared<norm2tex::HeightAtlas>(std::move(result.atlas));
+  return texture.atlas;
 }
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -105,17 +106,10 @@ std::vector<std::string> splitList(const std::string& text) {
 
 std::shared_ptr<const norm2tex::HeightAtlas> loadAtlas(const norm2tex::cli::Arguments& args,
                                                        const norm2tex::TexturedMesh& mesh) {
-  if (const auto atlas_path = args.value("--atlas")) {
-    const cv::Mat heights = norm2tex::readImage(*atlas_path, cv::IMREAD_UNCHANGED, "atlas");
-    if (heights.type() != CV_32FC1) {
-      throw norm2tex::Error(
-          "atlas '" + *atlas_path +
-          "' must be a single-channel 32-bit float TIFF (norm2tex_bake -o X.tiff)");
-    }
-    return std::make_shared<norm2tex::HeightAtlas>(heights, cv::Mat1b(heights.size(), 255));
-  }
-  const std::string normal_map = args.value("--normal-map", mesh.normalTexturePath());
-  return normal_map.empty() ? nullptr : bakeCached(normal_map);
+  norm2tex::TextureSource source;
+  source.atlas = args.value("--atlas", "");
+  if (source.atlas.empty()) source.normal_map = args.value("--normal-map", "");
+  return loadTexture(source, mesh);
 }
 
 /// --sheet: rows = no texture, then each normal map; columns = press depths.
@@ -153,7 +147,9 @@ int renderSheet(const norm2tex::cli::Arguments& args, const norm2tex::SensorMode
   for (const std::string& map : maps) {
     addRow([&] {
       const norm2tex::cli::QuietStderr quiet_decoders;
-      return bakeCached(map);
+      norm2tex::TextureSource source;
+      source.normal_map = map;
+      return loadTexture(source, *mesh);
     }());
     row_labels.push_back(std::filesystem::path(map).stem().string() + ", beta " +
                          shortNumber(beta) + " mm");

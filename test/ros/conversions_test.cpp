@@ -1,4 +1,6 @@
 // Conversions between core types and ROS messages (no master needed).
+#include <cstring>
+
 #include <gtest/gtest.h>
 
 #include "conversions.hpp"
@@ -58,6 +60,46 @@ TEST(ConversionsTest, ContactMessageCarriesEveryField) {
   EXPECT_DOUBLE_EQ(msg.contact_area, 4.9e-4);
   EXPECT_DOUBLE_EQ(msg.centroid.x, -0.001);
   EXPECT_DOUBLE_EQ(msg.centroid.y, 0.002);
+}
+
+TEST(ConversionsTest, ImagesKeepTheirPixelsAndEncodings) {
+  std_msgs::Header header;
+  header.frame_id = "digit_left_gel";
+  cv::Mat3b image(320, 240, cv::Vec3b(1, 2, 3));
+  image(319, 239) = cv::Vec3b(10, 20, 30);
+  const sensor_msgs::ImagePtr msg = ros_conversions::toImageMsg(header, image);
+  EXPECT_EQ(msg->encoding, "bgr8");
+  EXPECT_EQ(msg->height, 320u);
+  EXPECT_EQ(msg->width, 240u);
+  EXPECT_EQ(msg->step, 720u);
+  EXPECT_EQ(msg->data[0], 1);  // B first, as DIGIT drivers publish
+  EXPECT_EQ(msg->data[msg->data.size() - 1], 30);
+  // A view into a larger matrix (non-contiguous rows) is copied row by row.
+  cv::Mat1f big(10, 10, 0.0f);
+  big(3, 4) = 1.5f;
+  const sensor_msgs::ImagePtr depth =
+      ros_conversions::toImageMsg(header, big(cv::Rect(4, 3, 2, 2)));
+  EXPECT_EQ(depth->encoding, "32FC1");
+  float first = 0;
+  std::memcpy(&first, depth->data.data(), sizeof first);
+  EXPECT_EQ(first, 1.5f);
+  EXPECT_EQ(ros_conversions::toImageMsg(header, cv::Mat1b(2, 2))->encoding, "mono8");
+  EXPECT_THROW(ros_conversions::toImageMsg(header, cv::Mat1d(2, 2)), Error);
+}
+
+TEST(ConversionsTest, CameraInfoCarriesTheSensorIntrinsics) {
+  const SensorModel model = makeDigitSensorModel();
+  std_msgs::Header header;
+  header.stamp = ros::Time(3, 0);
+  const sensor_msgs::CameraInfo info = ros_conversions::toCameraInfo(header, model);
+  EXPECT_EQ(info.header.stamp, ros::Time(3, 0));
+  EXPECT_EQ(info.height, 320u);
+  EXPECT_EQ(info.width, 240u);
+  EXPECT_DOUBLE_EQ(info.K[0], model.fx);
+  EXPECT_DOUBLE_EQ(info.K[2], model.cx);
+  EXPECT_DOUBLE_EQ(info.K[5], model.cy);
+  EXPECT_DOUBLE_EQ(info.P[5], model.fy);
+  EXPECT_EQ(info.D.size(), 5u);
 }
 
 }  // namespace

@@ -2,11 +2,11 @@
 
 #include <opencv2/core.hpp>
 
-#include "norm2tex/texture/height_atlas.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/procedural_material.hpp"
 #include "norm2tex/mesh/textured_mesh.hpp"
 #include "norm2tex/mesh/uv_unwrap.hpp"
+#include "norm2tex/texture/height_atlas.hpp"
 
 namespace norm2tex {
 
@@ -34,10 +34,11 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
                                       int depth, int padding_texels);
 
 /// H_global of a material as it lies on `mesh`, ready for the TextureOverlay: the material
-/// (config's parameters, `seed`) rendered for the mesh's UV layout at config.size texels, encoded
-/// as a 16-bit normal map and baked with config.range, exactly as a user's normal map file would
-/// be. A mesh without UVs is replaced by its unwrapped copy first (so `mesh` may change).
+/// (variant `variant` of the config, see makeMaterialVariant; `seed`) rendered for the mesh's UV
+/// layout at config.size texels, encoded as a 16-bit normal map and baked with config.range,
+/// exactly as a user's normal map file would be. A mesh without UVs is replaced by its unwrapped
+/// copy first (so `mesh` may change).
 HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, TexturedMesh& mesh,
-                              int padding_texels = 4);
+                              int padding_texels = 4, int variant = 0);
 
 }  // namespace norm2tex

@@ -100,14 +100,14 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
 }
 
 HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, TexturedMesh& mesh,
-                              int padding_texels) {
+                              int padding_texels, int variant) {
   if (!mesh.hasUvs()) {
     UnwrapOptions options;
     options.texture_size = config.size;
     options.padding_texels = padding_texels;
     mesh = unwrapUvs(mesh, options).mesh;
   }
-  const auto material = makeMaterialVariant(config, 0, seed);
+  const auto material = makeMaterialVariant(config, variant, seed);
   const MaterialTexture texture = renderMaterialTexture(
       *material, computeUvLayout(mesh, cv::Size(config.size, config.size)), CV_16U, padding_texels);
   BakeOptions options;

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "norm2tex/mesh/textured_mesh.hpp"
+#include "norm2tex/texture/height_atlas.hpp"
+#include "norm2tex/texture/normal_map.hpp"
+
+namespace norm2tex {
+
+/// Where an object's texture comes from: at most one of a procedural material, a normal map or
+/// a baked atlas; none of them = the mesh's own normal texture, if it has one.
+struct TextureSource {
+  std::string material_config;  ///< config/materials/<name>.yaml
+  int variant = 0;              ///< material variant (0 = the config's own values)
+  std::uint64_t seed = 0;       ///< material seed
+  std::string normal_map;       ///< PNG/JPEG/TIFF normal map, baked through the AtlasCache
+  NormalConvention convention = NormalConvention::kOpenGL;
+  std::string atlas;  ///< a baked H_global: single-channel 32-bit float TIFF
+};
+
+/// H_global for the TextureOverlay, and what it came from.
+struct ObjectTexture {
+  std::shared_ptr<const HeightAtlas> atlas;  ///< null: no texture
+  double beta_mm = 0.0;                      ///< the material's beta; 0 when the source has none
+  std::string description;  ///< e.g. "material wood variant 3 seed 0", "normal map X (cached)"
+  std::string warning;      ///< non-empty when something worked only in part (cache not writable)
+};
+
+/// A normal map (baked through the AtlasCache), an atlas file, or with neither the mesh's own
+/// normal texture. Throws Error naming the file, or when `source` names a material.
+ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& mesh);
+
+/// Loads or bakes the texture. A procedural material is generated for `mesh`'s UV layout (a mesh
+/// without UVs is replaced by its unwrapped copy, so `mesh` may change). Throws Error naming the
+/// file at fault, or when more than one source is given.
+ObjectTexture loadObjectTexture(const TextureSource& source, TexturedMesh& mesh);
+
+}  // namespace norm2tex

@@ -1,0 +1,192 @@
+#include "tactile_renderer_ros.hpp"
+
+#include <filesystem>
+#include <sstream>
+
+#include <ros/package.h>
+
+#include "conversions.hpp"
+#include "norm2tex/FrameRendered.h"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/gripper_sim_config.hpp"
+
+namespace norm2tex {
+namespace {
+
+std::string packageFile(const std::string& relative) {
+  return ros::package::getPath("norm2tex") + "/" + relative;
+}
+
+[[noreturn]] void badParameter(const std::string& name, const std::string& value,
+                               const std::string& valid) {
+  throw Error("~" + name + " = " + value + " is not valid; valid: " + valid);
+}
+
+}  // namespace
+
+TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
+  TactileRendererParams p;
+  pnh.param<std::string>("sensor_name", p.sensor_name, p.sensor_name);
+  if (p.sensor_name.empty() || p.sensor_name.find(' ') != std::string::npos) {
+    badParameter("sensor_name", "'" + p.sensor_name + "'", "a topic name such as digit_left");
+  }
+  pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
+  pnh.param<std::string>("gel_frame", p.gel_frame, p.sensor_name + "_gel");
+  pnh.param<std::string>("object_frame", p.object_frame, p.object_frame);
+  pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
+  pnh.param<std::string>("mesh", p.mesh, "");
+  pnh.param("scale", p.scale, p.scale);
+  pnh.param<std::string>("normal_map", p.normal_map, "");
+  pnh.param<std::string>("convention", p.convention, p.convention);
+  pnh.param<std::string>("atlas", p.atlas, "");
+  // A material unless a texture file is given.
+  pnh.param<std::string>("material", p.material,
+                         p.normal_map.empty() && p.atlas.empty() ? "wood" : "");
+  if (!p.material.empty()) {
+    p.material_config = packageFile("config/materials/" + p.material + ".yaml");
+    if (p.material.find('/') != std::string::npos ||
+        !std::filesystem::is_regular_file(p.material_config)) {
+      std::string valid;
+      for (const auto& entry :
+           std::filesystem::directory_iterator(packageFile("config/materials"))) {
+        if (entry.path().extension() == ".yaml") {
+          valid += (valid.empty() ? "" : ", ") + entry.path().stem().string();
+        }
+      }
+      badParameter("material", "'" + p.material + "'",
+                   valid + " (config/materials/*.yaml), or '' with ~normal_map or ~atlas");
+    }
+  }
+  pnh.param("variant", p.variant, 0);
+  if (p.variant < 0) badParameter("variant", std::to_string(p.variant), ">= 0");
+  pnh.param("material_seed", p.material_seed, 0);
+  if (p.material_seed < 0) badParameter("material_seed", std::to_string(p.material_seed), ">= 0");
+  pnh.param("beta", p.beta, p.beta);
+  if (!(p.beta < 0.0 || p.beta <= 2.0)) {
+    badParameter("beta", std::to_string(p.beta), "[0, 2] mm, or < 0 for the material's");
+  }
+  pnh.param<std::string>("background", p.background, "");
+  pnh.param("noise_seed", p.noise_seed, 0);
+  pnh.param("publish_mask", p.publish_mask, false);
+  pnh.param("tf_timeout", p.tf_timeout, p.tf_timeout);
+  if (!(p.tf_timeout > 0.0 && p.tf_timeout <= 60.0)) {
+    badParameter("tf_timeout", std::to_string(p.tf_timeout), "(0, 60] s");
+  }
+  pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
+  return p;
+}
+
+TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : params_(readTactileRendererParams(private_nh)),
+      nh_(nh),
+      tf_buffer_(ros::Duration(30.0)),
+      tf_listener_(tf_buffer_, nh),
+      it_(nh) {
+  SensorModel model = loadSensorModel(params_.sensor);
+  if (!params_.background.empty()) model.background_image = params_.background;
+  renderer_ = std::make_unique<TactileRenderer>(model);
+
+  std::string mesh_spec = params_.mesh;
+  double scale = params_.scale;
+  if (mesh_spec.empty()) {
+    const GripperSimConfig scene = loadGripperSimConfig(params_.scene);
+    mesh_spec = scene.object.mesh;
+    scale = scene.object.scale;
+  }
+  auto mesh = std::make_shared<TexturedMesh>(loadObjectMesh(mesh_spec, scale).mesh);
+  TextureSource source;
+  source.material_config = params_.material_config;
+  source.variant = params_.variant;
+  source.seed = static_cast<std::uint64_t>(params_.material_seed);
+  source.normal_map = params_.normal_map;
+  source.convention = parseNormalConvention(params_.convention);
+  source.atlas = params_.atlas;
+  ROS_INFO("%s: preparing the texture of %s ...", params_.sensor_name.c_str(), mesh_spec.c_str());
+  const ros::WallTime start = ros::WallTime::now();
+  const ObjectTexture texture = loadObjectTexture(source, *mesh);
+  if (!texture.warning.empty())
+    ROS_WARN("%s: %s", params_.sensor_name.c_str(), texture.warning.c_str());
+  const double beta = params_.beta >= 0.0     ? params_.beta
+                      : texture.beta_mm > 0.0 ? texture.beta_mm
+                                              : 0.1;
+  const std::string warning = renderer_->setObject(mesh, texture.atlas, texture.atlas ? beta : 0.0);
+  if (!warning.empty()) ROS_WARN("%s: %s", params_.sensor_name.c_str(), warning.c_str());
+  ROS_INFO("%s: %s, beta %.3f mm, ready in %.2f s; rendering %s in %s on %s",
+           params_.sensor_name.c_str(), texture.atlas ? texture.description.c_str() : "no texture",
+           texture.atlas ? beta : 0.0, (ros::WallTime::now() - start).toSec(),
+           params_.object_frame.c_str(), params_.gel_frame.c_str(), params_.frame_topic.c_str());
+
+  const std::string& ns = params_.sensor_name;
+  image_pub_ = it_.advertise(ns + "/image_raw", 10);
+  info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>(ns + "/camera_info", 10);
+  depth_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/depth", 10);
+  if (params_.publish_mask) mask_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/contact_mask", 10);
+  rendered_pub_ = nh_.advertise<FrameRendered>(ns + "/rendered", 100);
+  // Frames in order, none dropped by the subscriber: synchronous mode sends one at a time, real
+  // time at most a few behind.
+  frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &TactileRendererRos::onFrame, this);
+}
+
+bool TactileRendererRos::anyoneListens() const {
+  return image_pub_.getNumSubscribers() > 0 || info_pub_.getNumSubscribers() > 0 ||
+         depth_pub_.getNumSubscribers() > 0 || (mask_pub_ && mask_pub_.getNumSubscribers() > 0);
+}
+
+void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
+  // Real time: skip the work when nobody listens. Synchronous: every frame is rendered.
+  if (!frame->acknowledge && !anyoneListens()) return;
+  FrameRendered answer;
+  answer.header.stamp = frame->header.stamp;
+  answer.header.frame_id = params_.gel_frame;
+  answer.sensor = params_.sensor_name;
+  answer.frame = frame->frame;
+  try {
+    // The pose at exactly this stamp: wait (wall clock: simulated time may stand still) for TF,
+    // never extrapolate or take a stale pose.
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.tf_timeout);
+    std::string why;
+    while (!tf_buffer_.canTransform(params_.gel_frame, params_.object_frame, frame->header.stamp,
+                                    &why)) {
+      if (ros::WallTime::now() > deadline || !ros::ok()) {
+        std::ostringstream reason;
+        reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at "
+               << frame->header.stamp
+               << " not available within ~tf_timeout = " << params_.tf_timeout << " s (" << why
+               << ")";
+        throw Error(reason.str());
+      }
+      ros::WallDuration(0.0002).sleep();
+    }
+    const Eigen::Isometry3d object_in_gel = ros_conversions::fromTransformMsg(
+        tf_buffer_.lookupTransform(params_.gel_frame, params_.object_frame, frame->header.stamp)
+            .transform);
+    const std::int64_t noise_seed = params_.noise_seed < 0
+                                        ? -1
+                                        : static_cast<std::int64_t>(params_.noise_seed) * 1000003 +
+                                              static_cast<std::int64_t>(frame->frame);
+    const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed);
+    std_msgs::Header header;
+    header.stamp = frame->header.stamp;
+    header.frame_id = params_.gel_frame;
+    image_pub_.publish(ros_conversions::toImageMsg(header, rendered.image));
+    info_pub_.publish(ros_conversions::toCameraInfo(header, renderer_->model()));
+    depth_pub_.publish(ros_conversions::toImageMsg(header, rendered.depthMetres()));
+    if (mask_pub_) mask_pub_.publish(ros_conversions::toImageMsg(header, rendered.contact_mask));
+    answer.published = true;
+    ++rendered_;
+  } catch (const Error& e) {
+    ++missed_;
+    answer.published = false;
+    answer.reason = e.what();
+    ROS_WARN_THROTTLE(1.0, "%s: frame %lu has no image (%lu of %lu frames so far): %s",
+                      params_.sensor_name.c_str(), static_cast<unsigned long>(frame->frame),
+                      static_cast<unsigned long>(missed_),
+                      static_cast<unsigned long>(missed_ + rendered_), e.what());
+  }
+  if (frame->acknowledge) rendered_pub_.publish(answer);
+}
+
+}  // namespace norm2tex

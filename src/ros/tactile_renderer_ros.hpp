@@ -1,0 +1,71 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <image_transport/image_transport.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "norm2tex/SimFrame.h"
+#include "norm2tex/render/tactile_renderer.hpp"
+
+namespace norm2tex {
+
+/// Validated private parameters of tactile_renderer (see README, "tactile_renderer").
+struct TactileRendererParams {
+  std::string sensor_name = "digit_left";  ///< ~sensor_name: topic namespace of the sensor
+  std::string sensor;                      ///< ~sensor: sensor yaml
+  std::string gel_frame;                   ///< ~gel_frame (default <sensor_name>_gel)
+  std::string object_frame = "object";     ///< ~object_frame
+  std::string scene;            ///< ~scene: the object mesh and scale come from this scene yaml ...
+  std::string mesh;             ///< ~mesh: ... unless given here (file or box:/sphere: primitive)
+  double scale = 1.0;           ///< ~scale with ~mesh
+  std::string material;         ///< ~material: procedural material name, or "" (see ~normal_map)
+  std::string material_config;  ///< resolved config/materials/<material>.yaml
+  int variant = 0;              ///< ~variant
+  int material_seed = 0;        ///< ~material_seed
+  std::string normal_map;       ///< ~normal_map: a normal map file instead of a material
+  std::string convention = "opengl";  ///< ~convention of the normal map: opengl | directx
+  std::string atlas;                  ///< ~atlas: a baked H_global float TIFF instead
+  double beta = -1.0;                 ///< ~beta [mm]; < 0: the material's beta_mm (0.1 for files)
+  std::string background;     ///< ~background: the user's no-contact DIGIT frame ("" = synthetic)
+  int noise_seed = 0;         ///< ~noise_seed; < 0: no noise
+  bool publish_mask = false;  ///< ~publish_mask: also /<sensor>/contact_mask (mono8)
+  double tf_timeout = 1.0;    ///< ~tf_timeout [s of wall time] for the pose at a frame's stamp
+  std::string frame_topic = "contact_sim/frame";  ///< ~frame_topic: SimFrame source
+};
+
+TactileRendererParams readTactileRendererParams(const ros::NodeHandle& private_nh);
+
+/// The tactile_renderer's work, shared by node and nodelet: for every SimFrame it looks up the
+/// object pose in the gel frame at exactly the frame's stamp, renders H_sensor + beta H_local
+/// through TactileRenderer, and publishes image_raw (bgr8), camera_info, depth (32FC1, m) and
+/// optionally contact_mask, all with the frame's stamp and the gel frame, then answers with a
+/// FrameRendered. A pose that does not arrive within ~tf_timeout is counted and warned about;
+/// no image is faked for it.
+class TactileRendererRos {
+ public:
+  /// Throws Error (bad parameter, unreadable sensor/scene/mesh/texture/background).
+  TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+ private:
+  void onFrame(const SimFrame::ConstPtr& frame);
+  bool anyoneListens() const;
+
+  TactileRendererParams params_;
+  std::unique_ptr<TactileRenderer> renderer_;
+  std::uint64_t rendered_ = 0, missed_ = 0;
+
+  ros::NodeHandle nh_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  image_transport::ImageTransport it_;
+  image_transport::Publisher image_pub_;
+  ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_;
+  ros::Subscriber frame_sub_;
+};
+
+}  // namespace norm2tex

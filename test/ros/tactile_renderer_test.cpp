@@ -1,0 +1,387 @@
+// rostests of the tactile renderers inside the whole simulated gripper (gripper_sim.launch):
+// real time (tactile_renderer.test), lock-step synchronous mode (tactile_renderer_sync.test) and
+// bad input (tactile_renderer_bad_input.test). Conditions are awaited with deadlines.
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/GripperCommand.h"
+#include "norm2tex/Reset.h"
+#include "norm2tex/Step.h"
+#include "norm2tex/TactileContact.h"
+
+namespace {
+
+bool waitFor(const std::function<bool()>& done, double seconds) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.001).sleep();
+  }
+  ros::spinOnce();
+  return done();
+}
+
+cv::Mat view(const sensor_msgs::Image& msg) {
+  const int type = msg.encoding == "bgr8" ? CV_8UC3 : msg.encoding == "mono8" ? CV_8UC1 : CV_32FC1;
+  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
+                 const_cast<std::uint8_t*>(msg.data.data()), msg.step);
+}
+
+// Everything one sensor published, by stamp.
+struct SensorLog {
+  std::vector<sensor_msgs::Image::ConstPtr> images;
+  std::map<ros::Time, sensor_msgs::Image::ConstPtr> image, depth, mask;
+  std::map<ros::Time, sensor_msgs::CameraInfo::ConstPtr> info;
+  norm2tex::TactileContact::ConstPtr contact;
+};
+
+struct Listener {
+  ros::NodeHandle nh;
+  tf2_ros::Buffer buffer{ros::Duration(60.0)};
+  tf2_ros::TransformListener tf{buffer, nh};
+  std::map<std::string, SensorLog> log;
+  std::vector<ros::Subscriber> subs;
+
+  explicit Listener(const std::vector<std::string>& sensors) {
+    for (const std::string& s : sensors) {
+      SensorLog* l = &log[s];
+      subs.push_back(nh.subscribe<sensor_msgs::Image>(s + "/image_raw", 1000, [l](const auto& m) {
+        l->images.push_back(m);
+        l->image[m->header.stamp] = m;
+      }));
+      subs.push_back(nh.subscribe<sensor_msgs::Image>(
+          s + "/depth", 1000, [l](const auto& m) { l->depth[m->header.stamp] = m; }));
+      subs.push_back(nh.subscribe<sensor_msgs::Image>(
+          s + "/contact_mask", 1000, [l](const auto& m) { l->mask[m->header.stamp] = m; }));
+      subs.push_back(nh.subscribe<sensor_msgs::CameraInfo>(
+          s + "/camera_info", 1000, [l](const auto& m) { l->info[m->header.stamp] = m; }));
+      subs.push_back(nh.subscribe<norm2tex::TactileContact>(
+          s + "/contact", 10, [l](const auto& m) { l->contact = m; }));
+    }
+  }
+  bool connected(int per_sensor_publishers) {
+    return waitFor(
+        [&] {
+          for (const ros::Subscriber& sub : subs) {
+            if (sub.getTopic().find("/contact") != std::string::npos &&
+                sub.getTopic().find("contact_mask") == std::string::npos) {
+              continue;  // renderers without physics sensors (extra renderers) have no contact
+            }
+            if (static_cast<int>(sub.getNumPublishers()) < per_sensor_publishers) return false;
+          }
+          return true;
+        },
+        60.0);
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Real time (sphere scene, masks on).
+
+TEST(RealTimeRendering, ImagesComeAtTheFrameRateWithMatchingInfoDepthAndTf) {
+  Listener l({"digit_left", "digit_right"});
+  ASSERT_TRUE(l.connected(1));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return l.log["digit_left"].images.size() >= 5 && l.log["digit_right"].images.size() >= 5;
+      },
+      30.0));
+  const std::size_t before = l.log["digit_left"].images.size();
+  const std::size_t before_right = l.log["digit_right"].images.size();
+  const ros::WallTime start = ros::WallTime::now();
+  waitFor([] { return false; }, 3.0);  // count what arrives in 3 s of wall time
+  const double seconds = (ros::WallTime::now() - start).toSec();
+  const double rate = (l.log["digit_left"].images.size() - before) / seconds;
+  const double rate_right = (l.log["digit_right"].images.size() - before_right) / seconds;
+  EXPECT_NEAR(rate, 60.0, 6.0);
+  EXPECT_NEAR(rate_right, 60.0, 6.0);
+
+  for (const std::string sensor : {"digit_left", "digit_right"}) {
+    SensorLog& s = l.log[sensor];
+    ASSERT_GE(s.images.size(), 10u) << sensor;
+    const sensor_msgs::Image& image = *s.images[s.images.size() - 10];
+    EXPECT_EQ(image.encoding, "bgr8");
+    EXPECT_EQ(image.height, 320u);
+    EXPECT_EQ(image.width, 240u);
+    EXPECT_EQ(image.header.frame_id, sensor + "_gel");
+    const ros::Time stamp = image.header.stamp;
+    ASSERT_TRUE(s.info.count(stamp) && s.depth.count(stamp) && s.mask.count(stamp)) << sensor;
+    EXPECT_EQ(s.depth[stamp]->encoding, "32FC1");
+    EXPECT_EQ(s.info[stamp]->header.frame_id, sensor + "_gel");
+    EXPECT_EQ(s.info[stamp]->width, 240u);
+    EXPECT_TRUE(l.buffer.canTransform(sensor + "_gel", "object", stamp)) << sensor;
+  }
+}
+
+TEST(RealTimeRendering, ContactShowsGrowsWithTheSqueezeAndEndsWhenDropped) {
+  Listener l({"digit_left", "digit_right"});
+  ros::Publisher command = l.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 10);
+  ASSERT_TRUE(l.connected(1));
+  ASSERT_TRUE(waitFor([&] { return command.getNumSubscribers() > 0; }, 20.0));
+  auto latest = [&](const std::string& sensor) {
+    SensorLog& s = l.log[sensor];
+    // The newest image whose depth and mask arrived too.
+    for (auto it = s.images.rbegin(); it != s.images.rend(); ++it) {
+      const ros::Time t = (*it)->header.stamp;
+      if (s.depth.count(t) && s.mask.count(t)) return t;
+    }
+    return ros::Time(0);
+  };
+  auto measure = [&](const std::string& sensor, ros::Time t, double& area, double& deepest) {
+    SensorLog& s = l.log[sensor];
+    area = cv::countNonZero(view(*s.mask[t]));
+    cv::minMaxLoc(view(*s.depth[t]), nullptr, &deepest);
+  };
+  ASSERT_TRUE(waitFor(
+      [&] { return latest("digit_left") > ros::Time(0) && latest("digit_right") > ros::Time(0); },
+      30.0));
+  std::map<std::string, ros::Time> held;
+  double area[2], depth[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string sensor = i ? "digit_right" : "digit_left";
+    held[sensor] = latest(sensor);
+    measure(sensor, held[sensor], area[i], depth[i]);
+    EXPECT_GT(area[i], 500) << sensor;
+    EXPECT_GT(depth[i], 0.2e-3) << sensor;
+  }
+
+  norm2tex::GripperCommand squeeze;
+  squeeze.mode = norm2tex::GripperCommand::DELTA;
+  squeeze.opening = -0.02;  // 0.8 mm narrower
+  command.publish(squeeze);
+  const ros::Time after = latest("digit_left") + ros::Duration(0.5);  // fingers move 20 mm/s
+  ASSERT_TRUE(
+      waitFor([&] { return latest("digit_left") > after && latest("digit_right") > after; }, 20.0));
+  for (int i = 0; i < 2; ++i) {
+    const std::string sensor = i ? "digit_right" : "digit_left";
+    double squeezed_area = 0, squeezed_depth = 0;
+    measure(sensor, latest(sensor), squeezed_area, squeezed_depth);
+    EXPECT_GT(squeezed_area, 1.2 * area[i]) << sensor;
+    EXPECT_GT(squeezed_depth, depth[i] + 0.2e-3) << sensor;
+  }
+
+  norm2tex::GripperCommand open;
+  open.mode = norm2tex::GripperCommand::ABSOLUTE;
+  open.opening = 1.0;
+  command.publish(open);
+  ASSERT_TRUE(waitFor(
+      [&] {
+        const auto& c0 = l.log["digit_left"].contact;
+        const auto& c1 = l.log["digit_right"].contact;
+        return c0 && c1 && !c0->in_contact && !c1->in_contact;
+      },
+      20.0));
+  const ros::Time gone = l.log["digit_left"].contact->header.stamp;
+  ASSERT_TRUE(
+      waitFor([&] { return latest("digit_left") > gone && latest("digit_right") > gone; }, 20.0));
+  for (int i = 0; i < 2; ++i) {
+    const std::string sensor = i ? "digit_right" : "digit_left";
+    const ros::Time t = latest(sensor);
+    double dropped_area = 0, dropped_depth = 0;
+    measure(sensor, t, dropped_area, dropped_depth);
+    EXPECT_EQ(dropped_area, 0) << sensor;
+    EXPECT_EQ(dropped_depth, 0.0) << sensor;
+    // While held, the image differed from the no-contact image inside the contact.
+    SensorLog& s = l.log[sensor];
+    cv::Mat diff;
+    cv::absdiff(view(*s.image[held[sensor]]), view(*s.image[t]), diff);
+    const cv::Scalar inside = cv::mean(diff, view(*s.mask[held[sensor]]));
+    EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 5.0) << sensor;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Synchronous: digit_left (wood), digit_right (wood), digit_left_rock (rock) and
+// digit_left_plain (wood at beta 0) and digit_left_bare (no texture), all on digit_left_gel
+// except digit_right; noise off.
+
+struct SyncFixture {
+  Listener l{
+      {"digit_left", "digit_right", "digit_left_rock", "digit_left_plain", "digit_left_bare"}};
+  ros::ServiceClient step = l.nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ros::ServiceClient reset = l.nh.serviceClient<norm2tex::Reset>("/contact_sim/reset");
+  bool ready() { return step.waitForExistence(ros::Duration(60.0)) && l.connected(1); }
+  ros::Time stepOnce(std::uint32_t frames = 1) {
+    norm2tex::Step srv;
+    srv.request.frames = frames;
+    EXPECT_TRUE(step.call(srv));
+    EXPECT_EQ(srv.response.missing_images, 0u);
+    return srv.response.stamp;
+  }
+  // All five renderers' images of `stamp` (published before ~step returned) arrive.
+  bool imagesOf(ros::Time stamp) {
+    return waitFor(
+        [&] {
+          for (auto& [name, s] : l.log) {
+            if (!s.image.count(stamp) || !s.mask.count(stamp)) return false;
+          }
+          return true;
+        },
+        10.0);
+  }
+};
+
+TEST(SynchronousRendering, EveryStepGivesExactlyOneImagePerSensorWithOneStamp) {
+  SyncFixture f;
+  ASSERT_TRUE(f.ready());
+  // A slow subscriber (5 ms per image) with room for every frame loses none.
+  int slow_count = 0;
+  ros::Subscriber slow =
+      f.l.nh.subscribe<sensor_msgs::Image>("digit_right/image_raw", 100, [&](const auto&) {
+        ros::WallDuration(0.005).sleep();  // simulates a slow consumer
+        ++slow_count;
+      });
+  ASSERT_TRUE(waitFor([&] { return slow.getNumPublishers() > 0; }, 20.0));
+  const std::size_t left0 = f.l.log["digit_left"].images.size();
+  const std::size_t right0 = f.l.log["digit_right"].images.size();
+  std::vector<ros::Time> stamps;
+  for (std::uint32_t frames : {1u, 1u, 5u, 1u, 20u, 2u}) stamps.push_back(f.stepOnce(frames));
+  const std::size_t expected = 1 + 1 + 5 + 1 + 20 + 2;
+  ASSERT_TRUE(f.imagesOf(stamps.back()));
+  ASSERT_TRUE(waitFor([&] { return slow_count >= static_cast<int>(expected); }, 20.0));
+  waitFor([] { return false; }, 0.3);  // any extra image would show up now
+  const auto& left = f.l.log["digit_left"].images;
+  const auto& right = f.l.log["digit_right"].images;
+  ASSERT_EQ(left.size() - left0, expected);
+  ASSERT_EQ(right.size() - right0, expected);
+  EXPECT_EQ(slow_count, static_cast<int>(expected));
+  for (std::size_t i = left0; i < left.size(); ++i) {
+    EXPECT_EQ(left[i]->header.stamp, right[i - left0 + right0]->header.stamp);
+    if (i > left0) {
+      EXPECT_EQ((left[i]->header.stamp - left[i - 1]->header.stamp).toNSec(), 16666667);
+    }
+  }
+  // Each call's stamp is its last frame's.
+  EXPECT_EQ(left.back()->header.stamp, stamps.back());
+}
+
+TEST(SynchronousRendering, MaterialChangesTextureNotContactAndBetaZeroIsTextureless) {
+  SyncFixture f;
+  ASSERT_TRUE(f.ready());
+  norm2tex::Reset episode;
+  episode.request.seed = 2;
+  episode.request.height_offset = 0.010;  // the cube's lower edge crosses the gel
+  ASSERT_TRUE(f.reset.call(episode));
+  const ros::Time t = f.stepOnce();
+  ASSERT_TRUE(f.imagesOf(t));
+  auto image = [&](const std::string& s) { return view(*f.l.log[s].image[t]); };
+  auto mask = [&](const std::string& s) { return view(*f.l.log[s].mask[t]); };
+  // Same geometry: identical contact masks.
+  EXPECT_EQ(cv::norm(mask("digit_left"), mask("digit_left_rock"), cv::NORM_INF), 0.0);
+  const int touching = cv::countNonZero(mask("digit_left"));
+  EXPECT_GT(touching, 5000);
+  EXPECT_LT(touching, 320 * 240 - 5000);
+  // Other material: other pixels inside the contact ...
+  cv::Mat diff;
+  cv::absdiff(image("digit_left"), image("digit_left_rock"), diff);
+  const cv::Scalar inside = cv::mean(diff, mask("digit_left"));
+  EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 1.0);
+  // ... and the very same pixels far from it (beyond the gel's skirt).
+  cv::Mat near;
+  cv::dilate(mask("digit_left"), near, cv::Mat(), cv::Point(-1, -1),
+             80);  // 6 x the gel's 1 mm blur
+  cv::Mat far;
+  cv::bitwise_not(near, far);
+  ASSERT_GT(cv::countNonZero(far), 1000);
+  EXPECT_EQ(cv::mean(diff, far)[0], 0.0);
+  // beta 0 renders exactly what no texture renders; with texture the contact differs.
+  EXPECT_EQ(cv::norm(image("digit_left_plain"), image("digit_left_bare"), cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(image("digit_left"), image("digit_left_bare"), cv::NORM_INF), 2.0);
+}
+
+TEST(SynchronousRendering, AOneMillimetreSlideShiftsTheTextureByOneMillimetre) {
+  SyncFixture f;
+  ASSERT_TRUE(f.ready());
+  // The cube 1 mm higher = 1 mm towards the image top: 1 / 0.08 = 12.5 pixels.
+  std::vector<cv::Mat> crops;
+  for (double offset : {0.000, 0.001}) {
+    norm2tex::Reset episode;
+    episode.request.seed = 3;
+    episode.request.height_offset = offset;
+    ASSERT_TRUE(f.reset.call(episode));
+    const ros::Time t = f.stepOnce();
+    ASSERT_TRUE(f.imagesOf(t));
+    cv::Mat gray, textured, bare, relief;
+    // Rock: random grains, so the correlation has one peak (wood's grain runs along the slide).
+    cv::cvtColor(view(*f.l.log["digit_left_rock"].image[t]), textured, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(view(*f.l.log["digit_left_bare"].image[t]), bare, cv::COLOR_BGR2GRAY);
+    // The texture alone: the textured frame minus the same frame without texture.
+    cv::subtract(textured, bare, relief, cv::noArray(), CV_32F);
+    crops.push_back(relief(cv::Rect(40, 60, 160, 160)).clone());
+  }
+  const cv::Point2d shift = cv::phaseCorrelate(crops[0], crops[1]);
+  EXPECT_NEAR(shift.y, -12.5, 0.5);
+  EXPECT_NEAR(shift.x, 0.0, 0.5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input.
+
+int runRenderer(const std::string& args, std::string& output) {
+  static int run = 0;
+  const std::string command = std::string(NORM2TEX_TACTILE_RENDERER_EXECUTABLE) +
+                              " __name:=renderer_bad_input_" + std::to_string(run++) + " " + args +
+                              " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[4096];
+  while (fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
+  struct Case {
+    std::string args, expected;
+  } cases[] = {
+      {"_mesh:=/nonexistent/object.stl", "/nonexistent/object.stl"},
+      {"_material:=unobtainium", "unobtainium"},
+      {"_material:='' _normal_map:=/nonexistent/normal.png", "/nonexistent/normal.png"},
+      {"_background:=/nonexistent/bg.png", "/nonexistent/bg.png"},
+      {"_tf_timeout:=-1", "~tf_timeout"},
+  };
+  for (const Case& c : cases) {
+    std::string output;
+    EXPECT_EQ(runRenderer(c.args, output), 1) << c.args << ":\n" << output;
+    EXPECT_NE(output.find(c.expected), std::string::npos) << c.args << ":\n" << output;
+  }
+}
+
+TEST(BadRendererInput, APoseThatNeverArrivesIsCountedNotFaked) {
+  // digit_ghost renders a frame that has no TF: every frame is reported missing, no image is
+  // published for it, and the renderer stays up.
+  Listener l({"digit_ghost"});
+  ros::ServiceClient step = l.nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  for (int i = 0; i < 3; ++i) {
+    norm2tex::Step srv;
+    srv.request.frames = 2;
+    ASSERT_TRUE(step.call(srv));
+    EXPECT_EQ(srv.response.missing_images, 2u);
+  }
+  waitFor([] { return false; }, 0.3);
+  EXPECT_TRUE(l.log["digit_ghost"].images.empty());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "tactile_renderer_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
