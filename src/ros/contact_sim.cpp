@@ -131,20 +131,25 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   startEpisode(params_.seed, params_.height_offset);
 
   if (params_.synchronous && !params_.renderers.empty()) {
-    ros::NodeHandle ack_nh(nh_);
+    ros::NodeHandle ack_nh(private_nh_);
     ack_nh.setCallbackQueue(&ack_queue_);
-    for (const std::string& sensor : params_.renderers) {
-      ack_subs_.push_back(
-          ack_nh.subscribe(sensor + "/rendered", 100, &ContactSim::onRendered, this));
-    }
+    // One topic for every renderer's answers: answers name their sensor.
+    ack_sub_ = ack_nh.subscribe("rendered", 100, &ContactSim::onRendered, this);
     ack_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &ack_queue_);
     ack_spinner_->start();
   }
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
-  reset_srv_ = private_nh_.advertiseService("reset", &ContactSim::onReset, this);
+  // ~reset and ~step block while the renderers work: they get a thread of their own, so that in
+  // a nodelet manager they never hold a worker thread a renderer's queue is pinned to.
+  ros::NodeHandle service_nh(private_nh_);
+  service_nh.setCallbackQueue(&service_queue_);
+  reset_srv_ = service_nh.advertiseService("reset", &ContactSim::onReset, this);
   if (params_.synchronous) {
-    step_srv_ = private_nh_.advertiseService("step", &ContactSim::onStep, this);
-  } else {
+    step_srv_ = service_nh.advertiseService("step", &ContactSim::onStep, this);
+  }
+  service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
+  service_spinner_->start();
+  if (!params_.synchronous) {
     timer_ =
         nh_.createWallTimer(ros::WallDuration(frame_period_ns_ * 1e-9), &ContactSim::onTimer, this);
   }
@@ -172,7 +177,9 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   sim_->step(static_cast<int>((ticks_per_frame_ - ticks % ticks_per_frame_) % ticks_per_frame_));
   frame_ = sim_->ticks() / ticks_per_frame_;
   if (!owns_clock_) {
-    // Wall-clock stamps: simulated time maps onto now (a reset's settling time is skipped).
+    // Wall-clock stamps: simulated time maps onto now (a reset's settling time is skipped);
+    // the timer's first frame re-anchors it, so stamps sit on the timer's grid.
+    anchor_to_wall_ = true;
     time_base_ =
         ros::Time::now() - (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
   } else {
@@ -265,39 +272,39 @@ void ContactSim::onTimer(const ros::WallTimerEvent&) {
 void ContactSim::advanceFrame() {
   sim_->step(ticks_per_frame_);
   ++frame_;
+  if (anchor_to_wall_) {
+    time_base_ =
+        ros::Time::now() - (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
+    anchor_to_wall_ = false;
+  }
   publishFrame();
 }
 
 void ContactSim::onRendered(const FrameRendered::ConstPtr& msg) {
   {
     std::lock_guard<std::mutex> lock(ack_mutex_);
-    last_ack_[msg->sensor] = *msg;
+    last_ack_[msg->sensor] = *msg;  // a renderer's first message (latched) says it is ready
   }
   ack_cv_.notify_all();
 }
 
 void ContactSim::waitForRenderers() {
-  // A renderer that is not yet connected would miss the frame (or its TF) and never answer.
-  const std::size_t needed = params_.renderers.size();
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.render_timeout);
-  auto connected = [&] {
-    if (frame_pub_.getNumSubscribers() < needed || tf_pub_.getNumSubscribers() < needed) {
-      return false;
-    }
-    for (const ros::Subscriber& sub : ack_subs_) {
-      if (sub.getNumPublishers() == 0) return false;
+  std::unique_lock<std::mutex> lock(ack_mutex_);
+  auto ready = [&] {
+    for (const std::string& sensor : params_.renderers) {
+      if (!last_ack_.count(sensor)) return false;
     }
     return true;
   };
-  while (!connected()) {
-    if (ros::WallTime::now() > deadline || !ros::ok()) {
-      std::string names;
-      for (const std::string& name : params_.renderers) names += " " + name;
-      throw Error("renderers" + names + " not connected within ~render_timeout = " +
-                  text(params_.render_timeout) + " s (are the tactile_renderer nodes running?)");
-    }
-    ros::WallDuration(0.001).sleep();
+  if (ack_cv_.wait_for(lock, std::chrono::duration<double>(params_.render_timeout), ready)) {
+    return;
   }
+  std::string missing;
+  for (const std::string& sensor : params_.renderers) {
+    if (!last_ack_.count(sensor)) missing += " " + sensor;
+  }
+  throw Error("renderers" + missing + " not ready within ~render_timeout = " +
+              text(params_.render_timeout) + " s (are the tactile_renderer nodes running?)");
 }
 
 std::uint32_t ContactSim::publishFrame() {
@@ -363,13 +370,21 @@ std::uint32_t ContactSim::publishFrame() {
     return it != last_ack_.end() && it->second.frame == frame.frame &&
            it->second.header.stamp == stamp;
   };
-  const bool all =
-      ack_cv_.wait_for(lock, std::chrono::duration<double>(params_.render_timeout), [&] {
-        for (const std::string& sensor : params_.renderers) {
-          if (!answered(sensor)) return false;
-        }
-        return true;
-      });
+  auto all_answered = [&] {
+    for (const std::string& sensor : params_.renderers) {
+      if (!answered(sensor)) return false;
+    }
+    return true;
+  };
+  // A renderer whose frame subscription is still connecting misses the message: offer the
+  // same frame again every 0.2 s (renderers answer a repeated frame without rendering it twice).
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(params_.render_timeout);
+  bool all = false;
+  while (!(all = ack_cv_.wait_for(lock, std::chrono::milliseconds(200), all_answered)) &&
+         std::chrono::steady_clock::now() < deadline && ros::ok()) {
+    frame_pub_.publish(frame);
+  }
   if (!all) {
     std::string missing;
     for (const std::string& sensor : params_.renderers) {

@@ -67,7 +67,7 @@ class ContactSim {
   /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.
   /// Returns how many of them published no image; throws Error when one did not answer in time.
   std::uint32_t publishFrame();
-  /// Waits (wall-clock deadline) until every renderer listens to the frames and TF.
+  /// Waits (wall-clock deadline) until every renderer of ~renderers has said it is ready.
   void waitForRenderers();
   ros::Time frameStamp() const;
 
@@ -79,6 +79,8 @@ class ContactSim {
   std::int64_t frame_ = 0;  ///< sensor frames since start (the simulated clock)
   ros::Time time_base_;     ///< added to simulated time: 0 with use_sim_time, else wall
   bool owns_clock_ = false;
+  /// Real time with wall stamps: re-anchor simulated time on the wall clock at the next frame.
+  bool anchor_to_wall_ = false;
   double beta_mm_ = 0.0;
   std::uint32_t episode_ = 0;
 
@@ -89,14 +91,18 @@ class ContactSim {
   ros::ServiceServer reset_srv_, step_srv_;
   ros::WallTimer timer_;
 
+  ros::CallbackQueue service_queue_;
   // FrameRendered answers arrive on their own queue and thread: ~step blocks the main queue
   // while it waits for them.
   ros::CallbackQueue ack_queue_;
-  std::unique_ptr<ros::AsyncSpinner> ack_spinner_;
-  std::vector<ros::Subscriber> ack_subs_;
+  ros::Subscriber ack_sub_;
   std::mutex ack_mutex_;
   std::condition_variable ack_cv_;
   std::map<std::string, FrameRendered> last_ack_;  ///< latest answer of each renderer
+
+  // Last: destroyed (stopped and joined) first, while everything their callbacks use exists.
+  std::unique_ptr<ros::AsyncSpinner> service_spinner_;
+  std::unique_ptr<ros::AsyncSpinner> ack_spinner_;
 };
 
 }  // namespace norm2tex

@@ -6,7 +6,6 @@
 #include <ros/package.h>
 
 #include "conversions.hpp"
-#include "norm2tex/FrameRendered.h"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/render/object_texture.hpp"
@@ -76,6 +75,7 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
     badParameter("tf_timeout", std::to_string(p.tf_timeout), "(0, 60] s");
   }
   pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
+  pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
   return p;
 }
 
@@ -124,10 +124,16 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>(ns + "/camera_info", 10);
   depth_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/depth", 10);
   if (params_.publish_mask) mask_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/contact_mask", 10);
-  rendered_pub_ = nh_.advertise<FrameRendered>(ns + "/rendered", 100);
   // Frames in order, none dropped by the subscriber: synchronous mode sends one at a time, real
-  // time at most a few behind.
+  // time at most a few behind. The answer topic comes last: contact_sim takes it as "ready".
   frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &TactileRendererRos::onFrame, this);
+  // Latched: contact_sim, whenever it subscribes, learns that this renderer is ready.
+  rendered_pub_ = nh_.advertise<FrameRendered>(params_.answer_topic, 100, /*latch=*/true);
+  FrameRendered ready;
+  ready.header.frame_id = params_.gel_frame;
+  ready.sensor = params_.sensor_name;
+  ready.reason = "ready";
+  rendered_pub_.publish(ready);
 }
 
 bool TactileRendererRos::anyoneListens() const {
@@ -138,6 +144,11 @@ bool TactileRendererRos::anyoneListens() const {
 void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   // Real time: skip the work when nobody listens. Synchronous: every frame is rendered.
   if (!frame->acknowledge && !anyoneListens()) return;
+  if (frame->acknowledge && answered_any_ && last_answer_.frame == frame->frame &&
+      last_answer_.header.stamp == frame->header.stamp) {
+    rendered_pub_.publish(last_answer_);  // offered again: answer again, render once
+    return;
+  }
   FrameRendered answer;
   answer.header.stamp = frame->header.stamp;
   answer.header.frame_id = params_.gel_frame;
@@ -186,7 +197,11 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
                       static_cast<unsigned long>(missed_),
                       static_cast<unsigned long>(missed_ + rendered_), e.what());
   }
-  if (frame->acknowledge) rendered_pub_.publish(answer);
+  if (frame->acknowledge) {
+    rendered_pub_.publish(answer);
+    last_answer_ = answer;
+    answered_any_ = true;
+  }
 }
 
 }  // namespace norm2tex

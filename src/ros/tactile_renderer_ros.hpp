@@ -9,6 +9,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "norm2tex/FrameRendered.h"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/render/tactile_renderer.hpp"
 
@@ -35,7 +36,8 @@ struct TactileRendererParams {
   int noise_seed = 0;         ///< ~noise_seed; < 0: no noise
   bool publish_mask = false;  ///< ~publish_mask: also /<sensor>/contact_mask (mono8)
   double tf_timeout = 1.0;    ///< ~tf_timeout [s of wall time] for the pose at a frame's stamp
-  std::string frame_topic = "contact_sim/frame";  ///< ~frame_topic: SimFrame source
+  std::string frame_topic = "contact_sim/frame";      ///< ~frame_topic: SimFrame source
+  std::string answer_topic = "contact_sim/rendered";  ///< ~answer_topic: FrameRendered sink
 };
 
 TactileRendererParams readTactileRendererParams(const ros::NodeHandle& private_nh);
@@ -58,6 +60,8 @@ class TactileRendererRos {
   TactileRendererParams params_;
   std::unique_ptr<TactileRenderer> renderer_;
   std::uint64_t rendered_ = 0, missed_ = 0;
+  bool answered_any_ = false;
+  FrameRendered last_answer_;  ///< repeated when contact_sim offers the same frame again
 
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_buffer_;

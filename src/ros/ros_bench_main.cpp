@@ -1,0 +1,117 @@
+// norm2tex_ros_bench: end-to-end speed of a running gripper_sim.launch, both sensors delivered
+// to this subscriber.
+//   norm2tex_ros_bench synchronous [FRAMES]   frames/s of ~step (one call per frame, the policy
+//                                             loop; and one call for all frames)
+//   norm2tex_ros_bench real_time [FRAMES]     latency from a frame's stamp to its images'
+//                                             arrival here (wall-clock stamps), p50 / p99 / max
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+
+#include "norm2tex/Step.h"
+
+namespace {
+
+struct Arrivals {
+  std::map<ros::Time, int> count;           // images per stamp (both sensors)
+  std::map<ros::Time, ros::WallTime> last;  // when the stamp's last image arrived
+  int total = 0;
+};
+
+template <typename F>
+bool waitFor(F done, double seconds) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    if (done()) return true;
+  }
+  return done();
+}
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "norm2tex_ros_bench", ros::init_options::AnonymousName);
+  const std::string mode = argc > 1 ? argv[1] : "";
+  const int frames = argc > 2 ? std::stoi(argv[2]) : 600;
+  if ((mode != "synchronous" && mode != "real_time") || frames < 10) {
+    std::fprintf(stderr, "usage: norm2tex_ros_bench synchronous|real_time [FRAMES >= 10]\n");
+    return 2;
+  }
+  ros::NodeHandle nh;
+  Arrivals arrivals;
+  auto on_image = [&](const sensor_msgs::Image::ConstPtr& m) {
+    ++arrivals.total;
+    ++arrivals.count[m->header.stamp];
+    arrivals.last[m->header.stamp] = ros::WallTime::now();
+  };
+  ros::Subscriber left = nh.subscribe<sensor_msgs::Image>("digit_left/image_raw", 1000, on_image);
+  ros::Subscriber right = nh.subscribe<sensor_msgs::Image>("digit_right/image_raw", 1000, on_image);
+  if (!waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60)) {
+    std::fprintf(stderr, "norm2tex_ros_bench: no image publishers within 60 s\n");
+    return 1;
+  }
+
+  if (mode == "synchronous") {
+    ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("contact_sim/step", true);
+    if (!step.waitForExistence(ros::Duration(60.0))) return 1;
+    norm2tex::Step srv;
+    srv.request.frames = 1;
+    for (int i = 0; i < 20; ++i) step.call(srv);  // warm up
+    waitFor([&] { return arrivals.count[srv.response.stamp] == 2; }, 10);
+    // The policy loop: step one frame, wait for both of its images.
+    ros::WallTime start = ros::WallTime::now();
+    for (int i = 0; i < frames; ++i) {
+      if (!step.call(srv)) return 1;
+      const ros::Time stamp = srv.response.stamp;
+      if (!waitFor([&] { return arrivals.count[stamp] == 2; }, 10)) return 1;
+    }
+    const double loop = (ros::WallTime::now() - start).toSec();
+    // One call for all frames, then wait for the last images.
+    const int before = arrivals.total;
+    start = ros::WallTime::now();
+    srv.request.frames = frames;
+    if (!step.call(srv)) return 1;
+    if (!waitFor([&] { return arrivals.total - before == 2 * frames; }, 60)) return 1;
+    const double batch = (ros::WallTime::now() - start).toSec();
+    std::printf(
+        "synchronous, %d frames, both sensors delivered: policy loop (step 1 + wait) "
+        "%.0f frames/s (%.2f ms/frame); one ~step of %d frames %.0f frames/s "
+        "(%.2f ms/frame); %d images lost\n",
+        frames, frames / loop, 1e3 * loop / frames, frames, frames / batch, 1e3 * batch / frames,
+        2 * frames - (arrivals.total - before));
+    return 0;
+  }
+
+  // Real time: stamps are wall time (use_sim_time false).
+  waitFor([&] { return arrivals.total >= 2 * 60; }, 30);
+  arrivals = Arrivals{};
+  waitFor([&] { return static_cast<int>(arrivals.count.size()) >= frames + 2; },
+          frames / 30.0 + 30);
+  std::vector<double> latency_ms;
+  int incomplete = 0;
+  for (const auto& [stamp, n] : arrivals.count) {
+    if (n != 2) {
+      ++incomplete;
+      continue;
+    }
+    latency_ms.push_back(1e3 * (arrivals.last[stamp].toSec() - stamp.toSec()));
+  }
+  if (latency_ms.size() < 10) return 1;
+  std::printf(
+      "real time, %zu frames: stamp -> both images here: p50 %.2f ms, p99 %.2f ms, "
+      "max %.2f ms; %d frames with one image\n",
+      latency_ms.size(), percentile(latency_ms, 0.5), percentile(latency_ms, 0.99),
+      percentile(latency_ms, 1.0), incomplete);
+  return 0;
+}
