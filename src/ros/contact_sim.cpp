@@ -12,6 +12,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "conversions.hpp"
+#include "markers.hpp"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
@@ -123,6 +124,8 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   frame_pub_ = private_nh_.advertise<SimFrame>("frame", 100);
+  markers_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
+  object_marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);
   joints_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   episode_pub_ = nh_.advertise<EpisodeInfo>("episode", 1, /*latch=*/true);
   for (int i = 0; i < 2; ++i) {
@@ -153,6 +156,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     timer_ =
         nh_.createWallTimer(ros::WallDuration(frame_period_ns_ * 1e-9), &ContactSim::onTimer, this);
   }
+  object_marker_pub_.publish(ros_conversions::objectMarker(sim_->object().mesh, ros::Time(0)));
   // Synchronous renderers get their first frame with the first step (or reset); publishing one
   // now would wait for renderers that may not have started yet.
   if (!params_.synchronous || params_.renderers.empty()) publishFrame();
@@ -352,6 +356,10 @@ std::uint32_t ContactSim::publishFrame() {
     header.frame_id = kGelFrames[i];
     const ContactPatch patch = meters_[i]->measure(sim_->object().mesh, state.object_in_gel);
     contact_pub_[i].publish(ros_conversions::toContactMsg(header, kSensorNames[i], state, patch));
+  }
+
+  if (markers_pub_.getNumSubscribers() > 0) {
+    markers_pub_.publish(ros_conversions::gripperMarkers(*sim_, stamp));
   }
 
   SimFrame frame;

@@ -87,6 +87,7 @@ class ContactSim {
   std::mutex mutex_;  // nodelet callbacks may run on several threads
   ros::NodeHandle nh_, private_nh_;
   ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, frame_pub_, contact_pub_[2];
+  ros::Publisher markers_pub_, object_marker_pub_;
   ros::Subscriber command_sub_;
   ros::ServiceServer reset_srv_, step_srv_;
   ros::WallTimer timer_;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "conversions.hpp"
+#include "markers.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -100,6 +101,36 @@ TEST(ConversionsTest, CameraInfoCarriesTheSensorIntrinsics) {
   EXPECT_DOUBLE_EQ(info.K[5], model.cy);
   EXPECT_DOUBLE_EQ(info.P[5], model.fy);
   EXPECT_EQ(info.D.size(), 5u);
+}
+
+TEST(MarkersTest, ObjectMeshAndForceArrowsFollowTheSimulation) {
+  GripperSimConfig config;
+  setGelFromSensor(makeDigitSensorModel(), config);
+  GripperSim sim(config);
+  const visualization_msgs::Marker object = ros_conversions::objectMarker(sim.object().mesh, {});
+  EXPECT_EQ(object.header.frame_id, "object");
+  EXPECT_EQ(object.points.size(), 3 * sim.object().mesh.triangles().size());
+  // Open: no contact, the arrows are deleted.
+  visualization_msgs::MarkerArray open = ros_conversions::gripperMarkers(sim, ros::Time(1, 0));
+  ASSERT_EQ(open.markers.size(), 6u);
+  for (const auto& m : open.markers) {
+    if (m.type == visualization_msgs::Marker::ARROW) {
+      EXPECT_EQ(m.action, visualization_msgs::Marker::DELETE);
+    }
+  }
+  // Held: the arrow is as long as the force says (5 mm per N) and points into the gel.
+  sim.reset(1, 0.0);
+  const visualization_msgs::MarkerArray held = ros_conversions::gripperMarkers(sim, {});
+  int arrows = 0;
+  for (const auto& m : held.markers) {
+    if (m.type != visualization_msgs::Marker::ARROW) continue;
+    ++arrows;
+    EXPECT_EQ(m.action, visualization_msgs::Marker::ADD);
+    const double force = sim.contact(m.id == 30 ? Finger::kLeft : Finger::kRight).normal_force_n;
+    EXPECT_NEAR(m.points[0].z - m.points[1].z, 0.005 * force, 1e-9);
+    EXPECT_EQ(m.header.frame_id, m.id == 30 ? "digit_left_gel" : "digit_right_gel");
+  }
+  EXPECT_EQ(arrows, 2);
 }
 
 }  // namespace
