@@ -73,15 +73,18 @@ struct Listener {
           s + "/contact", 10, [l](const auto& m) { l->contact = m; }));
     }
   }
+  // Every sensor's image_raw, depth and camera_info have a publisher.
   bool connected(int per_sensor_publishers) {
     return waitFor(
         [&] {
           for (const ros::Subscriber& sub : subs) {
-            if (sub.getTopic().find("/contact") != std::string::npos &&
-                sub.getTopic().find("contact_mask") == std::string::npos) {
-              continue;  // renderers without physics sensors (extra renderers) have no contact
+            const std::string topic = sub.getTopic();
+            const bool needed = topic.find("/image_raw") != std::string::npos ||
+                                topic.find("/depth") != std::string::npos ||
+                                topic.find("/camera_info") != std::string::npos;
+            if (needed && static_cast<int>(sub.getNumPublishers()) < per_sensor_publishers) {
+              return false;
             }
-            if (static_cast<int>(sub.getNumPublishers()) < per_sensor_publishers) return false;
           }
           return true;
         },
@@ -326,6 +329,39 @@ TEST(SynchronousRendering, AOneMillimetreSlideShiftsTheTextureByOneMillimetre) {
   const cv::Point2d shift = cv::phaseCorrelate(crops[0], crops[1]);
   EXPECT_NEAR(shift.y, -12.5, 0.5);
   EXPECT_NEAR(shift.x, 0.0, 0.5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Synchronous with contact_sim and both renderers as nodelets in one manager.
+
+TEST(SynchronousNodelets, EveryStepGivesExactlyOneImagePerSensorWithOneStamp) {
+  Listener l({"digit_left", "digit_right"});
+  ros::ServiceClient step = l.nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  ASSERT_TRUE(l.connected(1));
+  std::vector<ros::Time> stamps;
+  for (std::uint32_t frames : {1u, 3u, 1u, 10u}) {
+    norm2tex::Step srv;
+    srv.request.frames = frames;
+    ASSERT_TRUE(step.call(srv));
+    EXPECT_EQ(srv.response.missing_images, 0u);
+    stamps.push_back(srv.response.stamp);
+  }
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return l.log["digit_left"].image.count(stamps.back()) &&
+               l.log["digit_right"].image.count(stamps.back());
+      },
+      10.0));
+  waitFor([] { return false; }, 0.3);  // any extra image would show up now
+  for (const char* sensor : {"digit_left", "digit_right"}) {
+    const auto& images = l.log[sensor].images;
+    ASSERT_EQ(images.size(), 15u) << sensor;
+    for (std::size_t i = 1; i < images.size(); ++i) {
+      EXPECT_EQ((images[i]->header.stamp - images[i - 1]->header.stamp).toNSec(), 16666667);
+    }
+    EXPECT_EQ(images.back()->header.stamp, stamps.back());
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
