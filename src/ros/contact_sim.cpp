@@ -18,29 +18,19 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "params.hpp"
 
 namespace norm2tex {
 namespace {
 
+using ros_params::badParameter;
+using ros_params::materialConfigPath;
+using ros_params::packageFile;
+using ros_params::text;
+
 const char* const kSensorNames[2] = {"digit_left", "digit_right"};
 const char* const kGelFrames[2] = {"digit_left_gel", "digit_right_gel"};
 const char* const kFingerFrames[2] = {"finger_left", "finger_right"};
-
-std::string packageFile(const std::string& relative) {
-  return ros::package::getPath("norm2tex") + "/" + relative;
-}
-
-[[noreturn]] void badParameter(const std::string& name, const std::string& value,
-                               const std::string& valid) {
-  throw Error("~" + name + " = " + value + " is not valid; valid: " + valid);
-}
-
-template <typename T>
-std::string text(const T& value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 
 }  // namespace
 
@@ -55,17 +45,7 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
   pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
   pnh.param<std::string>("material", p.material, "wood");
-  p.material_config = packageFile("config/materials/" + p.material + ".yaml");
-  if (p.material.empty() || p.material.find('/') != std::string::npos ||
-      !std::filesystem::is_regular_file(p.material_config)) {
-    std::string valid;
-    for (const auto& entry : std::filesystem::directory_iterator(packageFile("config/materials"))) {
-      if (entry.path().extension() == ".yaml") {
-        valid += (valid.empty() ? "" : ", ") + entry.path().stem().string();
-      }
-    }
-    badParameter("material", "'" + p.material + "'", valid + " (config/materials/*.yaml)");
-  }
+  p.material_config = materialConfigPath(p.material);
   int seed = 0;
   pnh.param("seed", seed, 0);
   if (seed < 0) badParameter("seed", text(seed), ">= 0");
@@ -180,6 +160,7 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   const std::int64_t ticks = sim_->ticks();
   sim_->step(static_cast<int>((ticks_per_frame_ - ticks % ticks_per_frame_) % ticks_per_frame_));
   frame_ = sim_->ticks() / ticks_per_frame_;
+  wall_anchor_ = ros::WallTime();  // real time restarts from here
   if (!owns_clock_) {
     // Wall-clock stamps: simulated time maps onto now (a reset's settling time is skipped);
     // the timer's first frame re-anchors it, so stamps sit on the timer's grid.
@@ -270,7 +251,28 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
 
 void ContactSim::onTimer(const ros::WallTimerEvent&) {
   std::lock_guard<std::mutex> lock(mutex_);
-  advanceFrame();
+  // Physics follows the wall clock: a late timer (a loaded machine) catches up by stepping the
+  // frames that are due, at most a few at a time; further behind, it warns and lets them go.
+  constexpr int kMaxCatchUp = 4;
+  const ros::WallTime now = ros::WallTime::now();
+  if (wall_anchor_.isZero()) {  // first tick of an episode
+    wall_anchor_ = now;
+    anchor_frame_ = frame_;
+  }
+  const std::int64_t due =
+      anchor_frame_ + 1 +
+      static_cast<std::int64_t>((now - wall_anchor_).toNSec() / frame_period_ns_);
+  int stepped = 0;
+  while (frame_ < due && stepped < kMaxCatchUp) {
+    advanceFrame();
+    ++stepped;
+  }
+  if (frame_ < due) {
+    ROS_WARN_THROTTLE(5.0, "contact_sim: %ld frames behind real time; skipping them",
+                      static_cast<long>(due - frame_));
+    wall_anchor_ = now;
+    anchor_frame_ = frame_ - 1;
+  }
 }
 
 void ContactSim::advanceFrame() {

@@ -81,6 +81,8 @@ class ContactSim {
   bool owns_clock_ = false;
   /// Real time with wall stamps: re-anchor simulated time on the wall clock at the next frame.
   bool anchor_to_wall_ = false;
+  ros::WallTime wall_anchor_;  ///< real time: when frame anchor_frame_ + 1 was due
+  std::int64_t anchor_frame_ = 0;
   double beta_mm_ = 0.0;
   std::uint32_t episode_ = 0;
 

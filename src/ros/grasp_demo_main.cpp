@@ -18,8 +18,11 @@
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
+#include "wait_for.hpp"
 
 namespace {
+
+using norm2tex::waitFor;
 
 const char* const kSensors[2] = {"digit_left", "digit_right"};
 
@@ -27,18 +30,6 @@ struct Latest {
   std::map<std::string, sensor_msgs::Image::ConstPtr> images;
   std::map<std::string, norm2tex::TactileContact::ConstPtr> contacts;
 };
-
-// Spins until `done` or the wall-clock deadline.
-template <typename F>
-bool waitFor(F done, double seconds) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.001).sleep();
-  }
-  return done();
-}
 
 cv::Mat3b toMat(const sensor_msgs::Image& msg) {
   if (msg.encoding != "bgr8") throw std::runtime_error("expected bgr8, got " + msg.encoding);

@@ -14,24 +14,17 @@
 #include <sensor_msgs/Image.h>
 
 #include "norm2tex/Step.h"
+#include "wait_for.hpp"
 
 namespace {
+
+using norm2tex::waitFor;
 
 struct Arrivals {
   std::map<ros::Time, int> count;           // images per stamp (both sensors)
   std::map<ros::Time, ros::WallTime> last;  // when the stamp's last image arrived
   int total = 0;
 };
-
-template <typename F>
-bool waitFor(F done, double seconds) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-  }
-  return done();
-}
 
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());

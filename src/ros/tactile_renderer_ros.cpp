@@ -11,18 +11,13 @@
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
+#include "params.hpp"
 
 namespace norm2tex {
 namespace {
 
-std::string packageFile(const std::string& relative) {
-  return ros::package::getPath("norm2tex") + "/" + relative;
-}
-
-[[noreturn]] void badParameter(const std::string& name, const std::string& value,
-                               const std::string& valid) {
-  throw Error("~" + name + " = " + value + " is not valid; valid: " + valid);
-}
+using ros_params::badParameter;
+using ros_params::packageFile;
 
 }  // namespace
 
@@ -45,19 +40,8 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("material", p.material,
                          p.normal_map.empty() && p.atlas.empty() ? "wood" : "");
   if (!p.material.empty()) {
-    p.material_config = packageFile("config/materials/" + p.material + ".yaml");
-    if (p.material.find('/') != std::string::npos ||
-        !std::filesystem::is_regular_file(p.material_config)) {
-      std::string valid;
-      for (const auto& entry :
-           std::filesystem::directory_iterator(packageFile("config/materials"))) {
-        if (entry.path().extension() == ".yaml") {
-          valid += (valid.empty() ? "" : ", ") + entry.path().stem().string();
-        }
-      }
-      badParameter("material", "'" + p.material + "'",
-                   valid + " (config/materials/*.yaml), or '' with ~normal_map or ~atlas");
-    }
+    p.material_config =
+        ros_params::materialConfigPath(p.material, ", or '' with ~normal_map or ~atlas");
   }
   pnh.param("variant", p.variant, 0);
   if (p.variant < 0) badParameter("variant", std::to_string(p.variant), ">= 0");

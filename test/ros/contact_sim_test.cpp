@@ -18,20 +18,12 @@
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
+#include "run_node.hpp"
+#include "wait_for.hpp"
 
 namespace {
 
-// Spins until `done` holds or `seconds` of wall time pass.
-bool waitFor(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.002).sleep();
-  }
-  ros::spinOnce();
-  return done();
-}
+using norm2tex::waitFor;
 
 struct Listener {
   ros::NodeHandle nh;
@@ -57,21 +49,8 @@ struct Listener {
       nh.subscribe<norm2tex::EpisodeInfo>("/episode", 1, [this](const auto& m) { episode = m; })};
 };
 
-// Runs the contact_sim executable with extra arguments against this test's master; returns its
-// exit status and everything it printed.
-// Private parameters given as _name:=value stay on the parameter server: each run gets its own
-// node name.
 int runContactSim(const std::string& args, std::string& output) {
-  static int run = 0;
-  const std::string command = std::string(NORM2TEX_CONTACT_SIM_EXECUTABLE) +
-                              " __name:=contact_sim_bad_input_" + std::to_string(run++) + " " +
-                              args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  while (fgets(buffer, sizeof buffer, pipe)) output += buffer;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return norm2tex::test::runNodeUntilExit(NORM2TEX_CONTACT_SIM_EXECUTABLE, args, output);
 }
 
 TEST(RealTime, TfJointStatesAndContactsPublishWithOneStamp) {

@@ -21,19 +21,12 @@
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
+#include "run_node.hpp"
+#include "wait_for.hpp"
 
 namespace {
 
-bool waitFor(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.001).sleep();
-  }
-  ros::spinOnce();
-  return done();
-}
+using norm2tex::waitFor;
 
 cv::Mat view(const sensor_msgs::Image& msg) {
   const int type = msg.encoding == "bgr8" ? CV_8UC3 : msg.encoding == "mono8" ? CV_8UC1 : CV_32FC1;
@@ -368,16 +361,7 @@ TEST(SynchronousNodelets, EveryStepGivesExactlyOneImagePerSensorWithOneStamp) {
 // Bad input.
 
 int runRenderer(const std::string& args, std::string& output) {
-  static int run = 0;
-  const std::string command = std::string(NORM2TEX_TACTILE_RENDERER_EXECUTABLE) +
-                              " __name:=renderer_bad_input_" + std::to_string(run++) + " " + args +
-                              " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  while (fgets(buffer, sizeof buffer, pipe)) output += buffer;
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return norm2tex::test::runNodeUntilExit(NORM2TEX_TACTILE_RENDERER_EXECUTABLE, args, output);
 }
 
 TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
