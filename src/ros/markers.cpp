@@ -36,6 +36,7 @@ visualization_msgs::Marker objectMarker(const TexturedMesh& mesh, const ros::Tim
   visualization_msgs::Marker m =
       base("object", 0, visualization_msgs::Marker::TRIANGLE_LIST, stamp);
   rgb(m, 0.80, 0.62, 0.42);  // wood-ish
+  m.frame_locked = true;     // latched once: rviz must move it with the object frame
   m.points.reserve(mesh.triangles().size() * 3);
   for (const Eigen::Vector3i& t : mesh.triangles()) {
     for (int k = 0; k < 3; ++k) {

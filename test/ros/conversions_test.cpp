@@ -109,6 +109,7 @@ TEST(MarkersTest, ObjectMeshAndForceArrowsFollowTheSimulation) {
   GripperSim sim(config);
   const visualization_msgs::Marker object = ros_conversions::objectMarker(sim.object().mesh, {});
   EXPECT_EQ(object.header.frame_id, "object");
+  EXPECT_TRUE(object.frame_locked);  // latched once, it follows the object's TF
   EXPECT_EQ(object.points.size(), 3 * sim.object().mesh.triangles().size());
   // Open: no contact, the arrows are deleted.
   visualization_msgs::MarkerArray open = ros_conversions::gripperMarkers(sim, ros::Time(1, 0));
