@@ -259,9 +259,11 @@ void ContactSim::onTimer(const ros::WallTimerEvent&) {
     wall_anchor_ = now;
     anchor_frame_ = frame_;
   }
+  // Rounded, not floored: ticks jitter around their schedule, and a tick a little early must
+  // still step its frame (floored, every frame would come one tick late).
   const std::int64_t due =
       anchor_frame_ + 1 +
-      static_cast<std::int64_t>((now - wall_anchor_).toNSec() / frame_period_ns_);
+      ((now - wall_anchor_).toNSec() + frame_period_ns_ / 2) / frame_period_ns_;
   int stepped = 0;
   while (frame_ < due && stepped < kMaxCatchUp) {
     advanceFrame();
