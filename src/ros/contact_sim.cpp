@@ -43,6 +43,9 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   }
   p.synchronous = mode == "synchronous";
   pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
+  pnh.param<std::string>("mesh", p.mesh, "");
+  pnh.param("scale", p.scale, p.scale);
+  if (!(p.scale > 0.0 && p.scale <= 1000.0)) badParameter("scale", text(p.scale), "(0, 1000]");
   pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
   pnh.param<std::string>("material", p.material, "wood");
   p.material_config = materialConfigPath(p.material);
@@ -82,6 +85,11 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   beta_mm_ = params_.beta >= 0.0 ? params_.beta : material.beta_mm;
   const SensorModel sensor = loadSensorModel(params_.sensor);
   GripperSimConfig config = loadGripperSimConfig(params_.scene);
+  if (!params_.mesh.empty()) {
+    config.object.mesh = params_.mesh;
+    config.object.scale = params_.scale;
+    config.object.name = std::filesystem::path(params_.mesh).stem().string();
+  }
   config.object.friction = material.friction;
   config.object.material = params_.material;
   setGelFromSensor(sensor, config);
@@ -262,8 +270,7 @@ void ContactSim::onTimer(const ros::WallTimerEvent&) {
   // Rounded, not floored: ticks jitter around their schedule, and a tick a little early must
   // still step its frame (floored, every frame would come one tick late).
   const std::int64_t due =
-      anchor_frame_ + 1 +
-      ((now - wall_anchor_).toNSec() + frame_period_ns_ / 2) / frame_period_ns_;
+      anchor_frame_ + 1 + ((now - wall_anchor_).toNSec() + frame_period_ns_ / 2) / frame_period_ns_;
   int stepped = 0;
   while (frame_ < due && stepped < kMaxCatchUp) {
     advanceFrame();

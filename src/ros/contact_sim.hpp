@@ -25,6 +25,8 @@ namespace norm2tex {
 struct ContactSimParams {
   bool synchronous = false;      ///< ~mode: "real_time" | "synchronous"
   std::string scene;             ///< ~scene: scene yaml
+  std::string mesh;              ///< ~mesh: replaces the scene's object mesh when set
+  double scale = 1.0;            ///< ~scale of ~mesh (0.001 for millimetres)
   std::string sensor;            ///< ~sensor: sensor yaml (gel size and thickness)
   std::string material;          ///< ~material: config/materials/<material>.yaml gives the friction
   std::string material_config;   ///< the yaml resolved from ~material

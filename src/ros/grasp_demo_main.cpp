@@ -169,7 +169,7 @@ int main(int argc, char** argv) {
   }
   const std::string strip = (out / "grasp_sequence.png").string();
   cv::imwrite(strip, norm2tex::cli::makeContactSheet(tiles, {"digit_left", "digit_right"}, labels));
-  std::printf("grasp sequence (both sensors) -> %s; the cube %s\n", strip.c_str(),
+  std::printf("grasp sequence (both sensors) -> %s; the object %s\n", strip.c_str(),
               srv.response.dropped ? "dropped" : "did not drop");
   return srv.response.dropped ? 0 : 1;
 }
