@@ -45,10 +45,11 @@ std::shared_ptr<const norm2tex::HeightAtlas> atlas() {
 }
 
 void renderLoop(benchmark::State& state, std::shared_ptr<const norm2tex::TexturedMesh> mesh,
-                double beta_mm, std::int64_t seed, bool at_pole = false) {
+                double beta_mm, std::int64_t seed, bool at_pole = false,
+                const Eigen::Isometry3d* pose_override = nullptr) {
   norm2tex::TactileRenderer renderer(norm2tex::makeDigitSensorModel());
   renderer.setObject(std::move(mesh), beta_mm > 0 ? atlas() : nullptr, beta_mm);
-  const Eigen::Isometry3d pose = pressedSphere(at_pole);
+  const Eigen::Isometry3d pose = pose_override ? *pose_override : pressedSphere(at_pole);
   int frame = 0;
   for (auto _ : state) {
     const norm2tex::TactileFrame& out = renderer.render(pose, seed < 0 ? -1 : seed + frame++);
@@ -64,6 +65,15 @@ void BM_Render_Textured_AtUvPole(benchmark::State& state) {
 }
 void BM_Render_Textured_200kTriangles(benchmark::State& state) {
   renderLoop(state, sphere(317, 317), 0.2, 1);
+}
+// The gripper's scene: the 30 mm cube held 1 mm deep, its face over the whole gel but its lower
+// edge (7 mm below the gel centre): the contact covers 3/4 of the image.
+void BM_Render_Textured_HeldCube(benchmark::State& state) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(0.0, -0.008, 0.014);
+  renderLoop(state, std::make_shared<norm2tex::TexturedMesh>(
+                        norm2tex::makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02)),
+             0.2, 1, false, &pose);
 }
 
 // --- stages ---------------------------------------------------------------------------------
@@ -112,6 +122,7 @@ BENCHMARK(BM_Render_Textureless)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_AtUvPole)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_200kTriangles)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Render_Textured_HeldCube)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Stage_Raster)->ArgName("uv")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Overlay)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Gel)->Unit(benchmark::kMicrosecond);
