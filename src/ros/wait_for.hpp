@@ -9,12 +9,14 @@
 namespace norm2tex {
 
 /// Spins the global queue until `done()` holds or `seconds` of wall time pass; returns done().
-inline bool waitFor(const std::function<bool()>& done, double seconds) {
+/// `poll_seconds` between checks: raise it when done() is costly (e.g. asks the master).
+inline bool waitFor(const std::function<bool()>& done, double seconds,
+                    double poll_seconds = 0.0005) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
   while (ros::ok() && ros::WallTime::now() < deadline) {
     ros::spinOnce();
     if (done()) return true;
-    ros::WallDuration(0.0005).sleep();
+    ros::WallDuration(poll_seconds).sleep();
   }
   ros::spinOnce();
   return done();

@@ -36,12 +36,14 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <ros/master.h>
 #include <ros/package.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include "wait_for.hpp"
 
 namespace {
 
@@ -49,16 +51,9 @@ const char* const kRvizNode = "norm2tex_rviz_loads";
 constexpr int kRvizSeconds = 12;
 constexpr int kTimedOut = 124;  // timeout(1)'s exit status when the time ran out
 
-// Spins until `done` holds or `seconds` of wall time pass.
+// Conditions here ask the master: poll every 50 ms.
 bool waitFor(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.05).sleep();
-  }
-  ros::spinOnce();
-  return done();
+  return norm2tex::waitFor(done, seconds, 0.05);
 }
 
 std::string configPath() {
