@@ -1,0 +1,244 @@
+#include "dataset_recorder.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include <rosbag/exceptions.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include "norm2tex/TactileContact.h"
+
+#include "norm2tex/common/error.hpp"
+#include "params.hpp"
+
+namespace norm2tex {
+namespace {
+
+using ros_params::badParameter;
+using ros_params::text;
+
+bool endsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+}  // namespace
+
+DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
+  DatasetRecorderParams p;
+  if (!pnh.getParam("output_dir", p.output_dir) || p.output_dir.empty()) {
+    badParameter("output_dir", "''", "a directory to write the bags into");
+  }
+  pnh.param<std::string>("prefix", p.prefix, p.prefix);
+  pnh.param("shard", p.shard, p.shard);
+  if (p.shard < 0) badParameter("shard", text(p.shard), ">= 0");
+  pnh.param("sensors", p.sensors, p.sensors);
+  p.topics = {"/tf", "/tf_static", "/joint_states", "/clock", "episode"};
+  pnh.param("topics", p.topics, p.topics);
+  pnh.param<std::string>("compression", p.compression, p.compression);
+  if (p.compression != "lz4" && p.compression != "bz2" && p.compression != "none") {
+    badParameter("compression", "'" + p.compression + "'", "lz4, bz2, none");
+  }
+  pnh.param("samples", p.samples, p.samples);
+  if (p.samples < 0) badParameter("samples", text(p.samples), ">= 0 (0: no limit)");
+  pnh.param<std::string>("answer_as", p.answer_as, p.answer_as);
+  pnh.param("split_mb", p.split_mb, p.split_mb);
+  if (!(p.split_mb >= 0.0)) badParameter("split_mb", text(p.split_mb), ">= 0 MB (0: one bag)");
+  return p;
+}
+
+DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : params_(readDatasetRecorderParams(private_nh)), nh_(nh) {
+  // An unwritable directory fails now, naming it, not at the first frame.
+  std::error_code ec;
+  std::filesystem::create_directories(params_.output_dir, ec);
+  const std::string probe = params_.output_dir + "/.norm2tex_write_test";
+  if (ec || !std::ofstream(probe)) {
+    throw Error("output directory '" + params_.output_dir + "' cannot be written" +
+                (ec ? ": " + ec.message() : std::string()));
+  }
+  std::filesystem::remove(probe, ec);
+  openNextBag();
+
+  answer_pub_ = nh_.advertise<FrameRendered>("contact_sim/rendered", 100, /*latch=*/true);
+  std::vector<std::string> topics = params_.topics;
+  for (const std::string& sensor : params_.sensors) {
+    for (const char* leaf : {"/image_raw", "/camera_info", "/depth", "/contact"}) {
+      topics.push_back(sensor + leaf);
+    }
+  }
+  for (const std::string& topic : topics) {
+    const std::string resolved = nh_.resolveName(topic);
+    // Deep queues: in real time a slow disk must not drop frames unnoticed (drops are counted
+    // as received - written at the end).
+    subs_.push_back(nh_.subscribe<topic_tools::ShapeShifter>(
+        topic, 1000, [this, resolved](const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
+          onMessage(resolved, e);
+        }));
+  }
+  episode_sub_ = nh_.subscribe("episode", 10, &DatasetRecorder::onEpisode, this);
+  frame_sub_ = nh_.subscribe("contact_sim/frame", 100, &DatasetRecorder::onFrame, this);
+  if (!params_.answer_as.empty()) {
+    FrameRendered ready;
+    ready.sensor = params_.answer_as;
+    ready.reason = "ready";
+    answer_pub_.publish(ready);
+  }
+  started_ = last_progress_ = ros::WallTime::now();
+  ROS_INFO("dataset_recorder: %zu topics -> %s (%s), target %d images", topics.size(),
+           bag_paths_.back().c_str(), params_.compression.c_str(), params_.samples);
+}
+
+DatasetRecorder::~DatasetRecorder() { close(); }
+
+void DatasetRecorder::openNextBag() {
+  if (bag_) bag_->close();
+  const std::string path = params_.output_dir + "/" + params_.prefix + "_shard" +
+                           std::to_string(params_.shard) + "_" + std::to_string(bag_paths_.size()) +
+                           ".bag";
+  bag_ = std::make_unique<rosbag::Bag>();
+  try {
+    bag_->open(path, rosbag::bagmode::Write);
+  } catch (const rosbag::BagException& e) {
+    throw Error("bag '" + path + "' cannot be opened: " + e.what());
+  }
+  bag_->setCompression(params_.compression == "lz4"   ? rosbag::compression::LZ4
+                       : params_.compression == "bz2" ? rosbag::compression::BZ2
+                                                      : rosbag::compression::Uncompressed);
+  bag_paths_.push_back(path);
+}
+
+void DatasetRecorder::onEpisode(const EpisodeInfo::ConstPtr& info) { episode_ = *info; }
+
+void DatasetRecorder::onMessage(const std::string& topic,
+                                const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
+  ++received_[topic];
+  if (done_) return;
+  ros::Time when = ros::Time::now();
+  if (when < ros::TIME_MIN) when = ros::TIME_MIN;  // bags cannot hold time 0
+  try {
+    bag_->write(topic, when, e.getConstMessage(), e.getConnectionHeaderPtr());
+  } catch (const rosbag::BagException& ex) {
+    error_ = std::string("writing ") + topic + " to " + bag_paths_.back() + " failed: " + ex.what();
+    ROS_ERROR("dataset_recorder: %s; closing the bag", error_.c_str());
+    done_ = true;
+    return;
+  }
+  ++written_[topic];
+  // The frame this message belongs to, for the sensors' per-frame topics.
+  ros::Time stamp;
+  bool frame_part = true;
+  const topic_tools::ShapeShifter::ConstPtr& msg = e.getConstMessage();
+  if (endsWith(topic, "/image_raw") || endsWith(topic, "/depth")) {
+    stamp = msg->instantiate<sensor_msgs::Image>()->header.stamp;
+  } else if (endsWith(topic, "/camera_info")) {
+    stamp = msg->instantiate<sensor_msgs::CameraInfo>()->header.stamp;
+  } else if (endsWith(topic, "/contact")) {
+    stamp = msg->instantiate<TactileContact>()->header.stamp;
+  } else {
+    frame_part = false;
+  }
+  if (frame_part) ++parts_at_[stamp];
+  if (endsWith(topic, "/image_raw")) {
+    ++images_;
+    ++images_per_label_[episode_.material + "/variant" + std::to_string(episode_.variant)];
+    last_image_stamp_ = std::max(last_image_stamp_, stamp);
+    if (params_.samples > 0 && images_ >= static_cast<std::uint64_t>(params_.samples)) {
+      target_reached_ = true;
+    }
+    const ros::WallTime now = ros::WallTime::now();
+    if ((now - last_progress_).toSec() >= 1.0) {
+      last_progress_ = now;
+      const double rate = images_ / std::max(1e-9, (now - started_).toSec());
+      ROS_INFO("dataset_recorder: %lu images (%s) at %.0f/s%s", static_cast<unsigned long>(images_),
+               params_.samples > 0 ? (text(params_.samples) + " wanted").c_str() : "no limit", rate,
+               params_.samples > 0
+                   ? (", ETA " + text(static_cast<int>((params_.samples - images_) / rate)) + " s")
+                         .c_str()
+                   : "");
+    }
+  }
+  if (frame_part) answerFramesWritten();
+  // At the target, finish the frames already begun (every topic of the last frame), then stop.
+  if (target_reached_) {
+    bool open_frames = false;
+    for (const auto& [t, parts] : parts_at_) {
+      if (t <= last_image_stamp_ && !frameComplete(t)) open_frames = true;
+    }
+    if (!open_frames) done_ = true;
+  }
+  if (params_.split_mb > 0.0 && bag_->getSize() > params_.split_mb * 1e6) openNextBag();
+}
+
+void DatasetRecorder::onFrame(const SimFrame::ConstPtr& frame) {
+  if (!frame->acknowledge || params_.answer_as.empty()) return;
+  waiting_[frame->header.stamp] = frame->frame;
+  answerFramesWritten();
+}
+
+bool DatasetRecorder::frameComplete(const ros::Time& stamp) const {
+  const auto it = parts_at_.find(stamp);
+  return it != parts_at_.end() && it->second >= 4 * static_cast<int>(params_.sensors.size());
+}
+
+void DatasetRecorder::answerFramesWritten() {
+  // A synchronous frame is answered once every sensor's image, camera_info, depth and contact of
+  // it are in the bag.
+  for (auto it = waiting_.begin(); it != waiting_.end();) {
+    if (!frameComplete(it->first)) {
+      ++it;
+      continue;
+    }
+    FrameRendered answer;
+    answer.header.stamp = it->first;
+    answer.sensor = params_.answer_as;
+    answer.frame = it->second;
+    answer.published = true;
+    answer_pub_.publish(answer);
+    it = waiting_.erase(it);
+  }
+  // Forget complete frames nobody waits for (real time).
+  for (auto it = parts_at_.begin(); it != parts_at_.end();) {
+    it = frameComplete(it->first) && !waiting_.count(it->first) ? parts_at_.erase(it)
+                                                                : std::next(it);
+  }
+}
+
+void DatasetRecorder::close() {
+  if (closed_) return;
+  closed_ = true;
+  if (bag_) bag_->close();  // writes the index: `rosbag info` reads it
+  const std::string path = params_.output_dir + "/" + params_.prefix + "_shard" +
+                           std::to_string(params_.shard) + ".yaml";
+  std::ofstream manifest(path);
+  manifest << "# norm2tex dataset manifest (dataset_recorder)\n"
+           << "package_version: " << NORM2TEX_VERSION << "\n"
+           << "shard: " << params_.shard << "\n"
+           << "compression: " << params_.compression << "\n"
+           << "images: " << images_ << "\n"
+           << "samples_wanted: " << params_.samples << "\n"
+           << "complete: " << (error_.empty() ? "true" : "false") << "\n";
+  if (!error_.empty()) manifest << "error: \"" << error_ << "\"\n";
+  manifest << "bags:\n";
+  for (const std::string& bag : bag_paths_) {
+    manifest << "  - " << std::filesystem::path(bag).filename().string() << "\n";
+  }
+  manifest << "last_episode: {episode: " << episode_.episode << ", object: '" << episode_.object
+           << "', material: '" << episode_.material << "', variant: " << episode_.variant
+           << ", beta: " << episode_.beta << ", seed: " << episode_.seed << ", scenario: '"
+           << episode_.scenario << "'}\n"
+           << "images_per_label:\n";
+  for (const auto& [label, count] : images_per_label_) {
+    manifest << "  '" << label << "': " << count << "\n";
+  }
+  manifest << "topics:  # received / written\n";
+  for (const auto& [topic, count] : received_) {
+    manifest << "  '" << topic << "': {received: " << count << ", written: " << written_[topic]
+             << "}\n";
+  }
+  ROS_INFO("dataset_recorder: %lu images in %zu bag(s); manifest %s",
+           static_cast<unsigned long>(images_), bag_paths_.size(), path.c_str());
+}
+
+}  // namespace norm2tex

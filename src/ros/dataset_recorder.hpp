@@ -1,0 +1,87 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <topic_tools/shape_shifter.h>
+
+#include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/FrameRendered.h"
+#include "norm2tex/SimFrame.h"
+
+namespace norm2tex {
+
+/// Validated private parameters of dataset_recorder (see README, "dataset_recorder").
+struct DatasetRecorderParams {
+  std::string output_dir;           ///< ~output_dir: created if missing; must be writable
+  std::string prefix = "norm2tex";  ///< ~prefix: bags are <prefix>_shard<k>_<n>.bag
+  int shard = 0;                    ///< ~shard: recorded in the file names and the manifest
+  std::vector<std::string> sensors = {"digit_left", "digit_right"};  ///< ~sensors
+  std::vector<std::string> topics;  ///< ~topics: extra topics (default: TF, joints, clock, episode)
+  std::string compression = "lz4";  ///< ~compression: lz4 | bz2 | none
+  int samples = 0;                  ///< ~samples: tactile images to record, then exit; 0 = no limit
+  double split_mb = 0.0;            ///< ~split_mb: start a new bag past this size; 0 = one bag
+  /// ~answer_as: the name it answers synchronous frames under (list it in contact_sim's
+  /// ~renderers); "" = never answer.
+  std::string answer_as = "recorder";
+};
+
+DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& private_nh);
+
+/// Writes every message of the sensors' image_raw, camera_info, depth and contact topics and the
+/// extra topics into rosbags, counting what it received and wrote per topic and the images per
+/// episode label. In synchronous mode it answers each SimFrame (as sensor "recorder" on
+/// contact_sim/rendered) once every sensor's image of that frame is written, so contact_sim can
+/// wait for it: received = written. Closes (indexes) the bag and writes <prefix>_shard<k>.yaml,
+/// the manifest, on close(): at the sample target, on SIGINT/SIGTERM, or on a write error.
+class DatasetRecorder {
+ public:
+  /// Throws Error for bad parameters or an output directory that cannot be written.
+  DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~DatasetRecorder();
+
+  /// True once the sample target is reached or a write failed (the node then exits).
+  bool done() const { return done_; }
+  /// Closes the current bag and writes the manifest; idempotent.
+  void close();
+  /// Non-empty when writing failed (e.g. a full disk): why.
+  const std::string& error() const { return error_; }
+
+ private:
+  void onMessage(const std::string& topic, const ros::MessageEvent<topic_tools::ShapeShifter>& e);
+  void onFrame(const SimFrame::ConstPtr& frame);
+  void onEpisode(const EpisodeInfo::ConstPtr& info);
+  void openNextBag();
+  void answerFramesWritten();
+  bool frameComplete(const ros::Time& stamp) const;
+
+  DatasetRecorderParams params_;
+  std::unique_ptr<rosbag::Bag> bag_;
+  std::vector<std::string> bag_paths_;
+  std::map<std::string, std::uint64_t> received_, written_;
+  /// Per frame stamp: messages written of the sensors' image_raw, camera_info, depth, contact;
+  /// a frame is complete at 4 per sensor.
+  std::map<ros::Time, int> parts_at_;
+  ros::Time last_image_stamp_;
+  bool target_reached_ = false;
+  std::map<ros::Time, std::uint64_t> waiting_;  ///< synchronous frames to answer, by stamp
+  std::map<std::string, std::uint64_t> images_per_label_;  ///< "material/variant" -> images
+  EpisodeInfo episode_;
+  std::uint64_t images_ = 0;
+  bool done_ = false, closed_ = false;
+  std::string error_;
+  ros::WallTime started_, last_progress_;
+
+  ros::NodeHandle nh_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Subscriber frame_sub_, episode_sub_;
+  ros::Publisher answer_pub_;
+};
+
+}  // namespace norm2tex
