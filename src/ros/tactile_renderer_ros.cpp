@@ -166,10 +166,18 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
     std_msgs::Header header;
     header.stamp = frame->header.stamp;
     header.frame_id = params_.gel_frame;
+    // The image always (one per frame); the others are built only for someone (a 300 kB depth
+    // copy per frame is not free).
     image_pub_.publish(ros_conversions::toImageMsg(header, rendered.image));
-    info_pub_.publish(ros_conversions::toCameraInfo(header, renderer_->model()));
-    depth_pub_.publish(ros_conversions::toImageMsg(header, rendered.depthMetres()));
-    if (mask_pub_) mask_pub_.publish(ros_conversions::toImageMsg(header, rendered.contact_mask));
+    if (info_pub_.getNumSubscribers() > 0) {
+      info_pub_.publish(ros_conversions::toCameraInfo(header, renderer_->model()));
+    }
+    if (depth_pub_.getNumSubscribers() > 0) {
+      depth_pub_.publish(ros_conversions::toImageMsg(header, rendered.depthMetres()));
+    }
+    if (mask_pub_ && mask_pub_.getNumSubscribers() > 0) {
+      mask_pub_.publish(ros_conversions::toImageMsg(header, rendered.contact_mask));
+    }
     answer.published = true;
     ++rendered_;
   } catch (const Error& e) {

@@ -74,6 +74,16 @@ TEST(DatasetRecorder, RecordsEveryLockStepFrameAndCtrlCLeavesAValidBag) {
           "_answer_as:=sigint_recorder", "_samples:=0", static_cast<char*>(nullptr));
     _exit(127);
   }
+  // However the test ends, the child does not outlive it.
+  struct Reaper {
+    pid_t pid;
+    ~Reaper() {
+      if (waitpid(pid, nullptr, WNOHANG) == 0) {
+        kill(pid, SIGKILL);
+        waitpid(pid, nullptr, 0);
+      }
+    }
+  } reaper{pid};
 
   // 10 frames in lock-step: each waits for both renderers and both recorders.
   ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("/contact_sim/step");
