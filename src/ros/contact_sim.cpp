@@ -121,14 +121,10 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   startEpisode(params_.seed, params_.height_offset);
 
-  if (params_.synchronous && !params_.renderers.empty()) {
-    ros::NodeHandle ack_nh(private_nh_);
-    ack_nh.setCallbackQueue(&ack_queue_);
-    // One topic for every renderer's answers: answers name their sensor.
-    ack_sub_ = ack_nh.subscribe("rendered", 100, &ContactSim::onRendered, this);
-    ack_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &ack_queue_);
-    ack_spinner_->start();
-  }
+  lock_step_ = std::make_unique<LockStep>(
+      private_nh_,
+      params_.synchronous ? params_.renderers : std::vector<std::string>(),
+      params_.render_timeout, "contact_sim");
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
   // ~reset and ~step block while the renderers work: they get a thread of their own, so that in
   // a nodelet manager they never hold a worker thread a renderer's queue is pinned to.
@@ -191,6 +187,7 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   info.seed = seed;
   info.scenario = params_.scenario;
   info.height_offset = start.height_offset_m;
+  info.num_shards = 1;
   episode_pub_.publish(info);
   return info;
 }
@@ -295,37 +292,10 @@ void ContactSim::advanceFrame() {
   publishFrame();
 }
 
-void ContactSim::onRendered(const FrameRendered::ConstPtr& msg) {
-  {
-    std::lock_guard<std::mutex> lock(ack_mutex_);
-    last_ack_[msg->sensor] = *msg;  // a renderer's first message (latched) says it is ready
-  }
-  ack_cv_.notify_all();
-}
-
-void ContactSim::waitForRenderers() {
-  std::unique_lock<std::mutex> lock(ack_mutex_);
-  auto ready = [&] {
-    for (const std::string& sensor : params_.renderers) {
-      if (!last_ack_.count(sensor)) return false;
-    }
-    return true;
-  };
-  if (ack_cv_.wait_for(lock, std::chrono::duration<double>(params_.render_timeout), ready)) {
-    return;
-  }
-  std::string missing;
-  for (const std::string& sensor : params_.renderers) {
-    if (!last_ack_.count(sensor)) missing += " " + sensor;
-  }
-  throw Error("renderers" + missing + " not ready within ~render_timeout = " +
-              text(params_.render_timeout) + " s (are the tactile_renderer nodes running?)");
-}
-
 std::uint32_t ContactSim::publishFrame() {
   const ros::Time stamp = frameStamp();
-  const bool acknowledge = params_.synchronous && !params_.renderers.empty();
-  if (acknowledge) waitForRenderers();
+  const bool acknowledge = lock_step_->waits();
+  if (acknowledge) lock_step_->waitUntilReady();
   if (owns_clock_) {
     rosgraph_msgs::Clock clock;
     clock.clock = stamp;
@@ -379,49 +349,10 @@ std::uint32_t ContactSim::publishFrame() {
   frame.frame = static_cast<std::uint64_t>(frame_);
   frame.episode = episode_;
   frame.acknowledge = acknowledge;
-  frame_pub_.publish(frame);
-  if (!acknowledge) return 0;
-
+  frame.material = params_.material;
+  frame.variant = static_cast<std::uint32_t>(params_.variant);
   // Lock-step: every renderer answers this frame before the next one is simulated.
-  std::unique_lock<std::mutex> lock(ack_mutex_);
-  auto answered = [&](const std::string& sensor) {
-    const auto it = last_ack_.find(sensor);
-    return it != last_ack_.end() && it->second.frame == frame.frame &&
-           it->second.header.stamp == stamp;
-  };
-  auto all_answered = [&] {
-    for (const std::string& sensor : params_.renderers) {
-      if (!answered(sensor)) return false;
-    }
-    return true;
-  };
-  // A renderer whose frame subscription is still connecting misses the message: offer the
-  // same frame again every 0.2 s (renderers answer a repeated frame without rendering it twice).
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(params_.render_timeout);
-  bool all = false;
-  while (!(all = ack_cv_.wait_for(lock, std::chrono::milliseconds(200), all_answered)) &&
-         std::chrono::steady_clock::now() < deadline && ros::ok()) {
-    frame_pub_.publish(frame);
-  }
-  if (!all) {
-    std::string missing;
-    for (const std::string& sensor : params_.renderers) {
-      if (!answered(sensor)) missing += " " + sensor;
-    }
-    throw Error("no answer from" + missing +
-                " within ~render_timeout = " + text(params_.render_timeout) + " s");
-  }
-  std::uint32_t missing_images = 0;
-  for (const std::string& sensor : params_.renderers) {
-    const FrameRendered& ack = last_ack_.at(sensor);
-    if (!ack.published) {
-      ++missing_images;
-      ROS_WARN("contact_sim: %s published no image for frame %lu: %s", sensor.c_str(),
-               static_cast<unsigned long>(frame.frame), ack.reason.c_str());
-    }
-  }
-  return missing_images;
+  return lock_step_->publishAndWait(frame_pub_, frame);
 }
 
 }  // namespace norm2tex

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -12,10 +11,10 @@
 #include <ros/ros.h>
 
 #include "norm2tex/EpisodeInfo.h"
-#include "norm2tex/FrameRendered.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
+#include "lock_step.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 
@@ -59,7 +58,6 @@ class ContactSim {
   bool onReset(Reset::Request& request, Reset::Response& response);
   bool onStep(Step::Request& request, Step::Response& response);
   void onTimer(const ros::WallTimerEvent& event);
-  void onRendered(const FrameRendered::ConstPtr& msg);
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
   bool applyCommand(const GripperCommand& command);
@@ -69,8 +67,6 @@ class ContactSim {
   /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.
   /// Returns how many of them published no image; throws Error when one did not answer in time.
   std::uint32_t publishFrame();
-  /// Waits (wall-clock deadline) until every renderer of ~renderers has said it is ready.
-  void waitForRenderers();
   ros::Time frameStamp() const;
 
   ContactSimParams params_;
@@ -97,17 +93,11 @@ class ContactSim {
   ros::WallTimer timer_;
 
   ros::CallbackQueue service_queue_;
-  // FrameRendered answers arrive on their own queue and thread: ~step blocks the main queue
-  // while it waits for them.
-  ros::CallbackQueue ack_queue_;
-  ros::Subscriber ack_sub_;
-  std::mutex ack_mutex_;
-  std::condition_variable ack_cv_;
-  std::map<std::string, FrameRendered> last_ack_;  ///< latest answer of each renderer
+  /// Synchronous mode with ~renderers: waits for every renderer's answer to each frame.
+  std::unique_ptr<LockStep> lock_step_;
 
-  // Last: destroyed (stopped and joined) first, while everything their callbacks use exists.
+  // Last: destroyed (stopped and joined) first, while everything its callbacks use exists.
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
-  std::unique_ptr<ros::AsyncSpinner> ack_spinner_;
 };
 
 }  // namespace norm2tex

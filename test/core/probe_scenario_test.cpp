@@ -11,6 +11,7 @@
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/probe_scenario.hpp"
+#include "norm2tex/sim/probe_schedule.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {
@@ -121,6 +122,46 @@ TEST(ProbeScenarioTest, BadConfigsAreRejected) {
   config = ProbeConfig();
   config.slide_step_max_m = NAN;
   test::expectError([&] { ProbeScenario(mesh.mesh, config, makeDigitSensorModel(), 0); }, {"slide_step_max_m"});
+}
+
+TEST(ProbeScheduleTest, SamplesSpreadOverVariantsAndShardsPartitionThePresses) {
+  const std::vector<std::pair<std::string, int>> materials = {{"wood", 24}, {"fabric", 7}};
+  const ProbeSchedule whole(materials, 6000, 5, 42);
+  ASSERT_EQ(whole.blocks().size(), 31u);
+  std::uint64_t wood = 0, fabric = 0;
+  for (const ProbeBlock& b : whole.blocks()) (b.material == "wood" ? wood : fabric) += b.frames;
+  EXPECT_EQ(wood, 6000u);
+  EXPECT_EQ(fabric, 6000u);
+  EXPECT_EQ(whole.blocks()[7].frames, 250u);                         // 6000 / 24
+  EXPECT_EQ(whole.blocks()[24].frames, 858u);                        // 6000 = 7 * 857 + 1
+  EXPECT_EQ(whole.blocks()[25].frames, 857u);
+  EXPECT_NE(whole.blocks()[0].scenario_seed, whole.blocks()[1].scenario_seed);
+  EXPECT_EQ(whole.frames(), 12000u);
+
+  // Three shards: disjoint, together the whole schedule press for press, balanced.
+  std::set<std::pair<int, std::uint64_t>> all;
+  std::uint64_t frames = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ProbeSchedule shard(materials, 6000, 5, 42, k, 3);
+    for (const ProbePress& p : shard.presses()) {
+      EXPECT_TRUE(all.insert({p.block, p.press}).second) << "press in two shards";
+    }
+    frames += shard.frames();
+    EXPECT_NEAR(static_cast<double>(shard.frames()), 4000.0, 31 * 5.0);
+  }
+  EXPECT_EQ(frames, whole.frames());
+  EXPECT_EQ(all.size(), whole.presses().size());
+  // The last press of a block is cut to the block's frames: 858 = 171 * 5 + 3.
+  const ProbePress& last = whole.presses()[1200 + 171];
+  EXPECT_EQ(last.block, 24);
+  EXPECT_EQ(last.frames, 3);
+}
+
+TEST(ProbeScheduleTest, BadPlansAreRejected) {
+  test::expectError([] { ProbeSchedule({}, 10, 5, 0); }, {"no material"});
+  test::expectError([] { ProbeSchedule({{"wood", 0}}, 10, 5, 0); }, {"wood", "variants"});
+  test::expectError([] { ProbeSchedule({{"wood", 2}}, 0, 5, 0); }, {"samples"});
+  test::expectError([] { ProbeSchedule({{"wood", 2}}, 10, 5, 0, 2, 2); }, {"shard 2 of 2"});
 }
 
 }  // namespace
