@@ -76,6 +76,10 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   if (!(p.render_timeout > 0.0 && p.render_timeout <= 600.0)) {
     badParameter("render_timeout", text(p.render_timeout), "(0, 600] s");
   }
+  pnh.param("ready_timeout", p.ready_timeout, p.ready_timeout);
+  if (!(p.ready_timeout > 0.0 && p.ready_timeout <= 3600.0)) {
+    badParameter("ready_timeout", text(p.ready_timeout), "(0, 3600] s");
+  }
   return p;
 }
 
@@ -124,7 +128,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   lock_step_ = std::make_unique<LockStep>(
       private_nh_,
       params_.synchronous ? params_.renderers : std::vector<std::string>(),
-      params_.render_timeout, "contact_sim");
+      params_.render_timeout, params_.ready_timeout, "contact_sim");
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
   // ~reset and ~step block while the renderers work: they get a thread of their own, so that in
   // a nodelet manager they never hold a worker thread a renderer's queue is pinned to.

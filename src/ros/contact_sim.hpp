@@ -40,6 +40,8 @@ struct ContactSimParams {
   /// [digit_left, digit_right]); empty: none.
   std::vector<std::string> renderers;
   double render_timeout = 5.0;  ///< ~render_timeout [s of wall time] for each FrameRendered
+  /// ~ready_timeout [s of wall time] for the renderers to start (texture bakes included)
+  double ready_timeout = 60.0;
 };
 
 /// Reads and validates the private parameters; throws Error naming the parameter and its valid

@@ -1,5 +1,7 @@
 #include "conversions.hpp"
 
+#include <opencv2/imgproc.hpp>
+
 #include <cstring>
 #include <limits>
 
@@ -87,6 +89,34 @@ sensor_msgs::ImagePtr toImageMsg(const std_msgs::Header& header, const cv::Mat& 
     std::memcpy(&msg->data[static_cast<std::size_t>(r) * msg->step], image.ptr(r), msg->step);
   }
   return msg;
+}
+
+cv::Mat fromImageMsg(const sensor_msgs::Image& msg) {
+  int type = -1;
+  if (msg.encoding == "bgr8" || msg.encoding == "rgb8") type = CV_8UC3;
+  if (msg.encoding == "mono8") type = CV_8UC1;
+  if (msg.encoding == "32FC1") type = CV_32FC1;
+  if (type < 0) {
+    throw Error("image encoding '" + msg.encoding +
+                "' is not supported here; valid: bgr8, rgb8, mono8, 32FC1");
+  }
+  if (msg.is_bigendian && type == CV_32FC1) {
+    throw Error("big-endian 32FC1 images are not supported");
+  }
+  const std::size_t row_bytes = static_cast<std::size_t>(msg.width) * CV_ELEM_SIZE(type);
+  if (msg.width == 0 || msg.height == 0 || msg.step < row_bytes ||
+      msg.data.size() < static_cast<std::size_t>(msg.step) * msg.height) {
+    throw Error("image message of " + std::to_string(msg.width) + " x " +
+                std::to_string(msg.height) + " " + msg.encoding + " with step " +
+                std::to_string(msg.step) + " holds " + std::to_string(msg.data.size()) +
+                " bytes: truncated or inconsistent");
+  }
+  cv::Mat image(static_cast<int>(msg.height), static_cast<int>(msg.width), type);
+  for (int r = 0; r < image.rows; ++r) {
+    std::memcpy(image.ptr(r), &msg.data[static_cast<std::size_t>(r) * msg.step], row_bytes);
+  }
+  if (msg.encoding == "rgb8") cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
+  return image;
 }
 
 sensor_msgs::CameraInfo toCameraInfo(const std_msgs::Header& header, const SensorModel& model) {

@@ -35,6 +35,11 @@ TactileContact toContactMsg(const std_msgs::Header& header, const std::string& s
 /// as "32FC1"; throws Error for any other type.
 sensor_msgs::ImagePtr toImageMsg(const std_msgs::Header& header, const cv::Mat& image);
 
+/// The pixels of an image message (a copy): "bgr8"/"rgb8" as CV_8UC3 BGR, "mono8" as CV_8UC1,
+/// "32FC1" as CV_32FC1. Throws Error naming the encoding for any other, and for a message whose
+/// step or data size does not match its width, height and encoding (a truncated message).
+cv::Mat fromImageMsg(const sensor_msgs::Image& msg);
+
 /// The sensor's pinhole intrinsics (no distortion), as a DIGIT driver would publish them.
 sensor_msgs::CameraInfo toCameraInfo(const std_msgs::Header& header, const SensorModel& model);
 

@@ -34,7 +34,9 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
   pnh.param("shard", p.shard, p.shard);
   if (p.shard < 0) badParameter("shard", text(p.shard), ">= 0");
   pnh.param("sensors", p.sensors, p.sensors);
+  pnh.param("sensors", p.sensors, p.sensors);
   p.topics = {"/tf", "/tf_static", "/joint_states", "/clock", "episode"};
+  for (const std::string& sensor : p.sensors) p.topics.push_back(sensor + "/background");
   pnh.param("topics", p.topics, p.topics);
   pnh.param<std::string>("compression", p.compression, p.compression);
   if (p.compression != "lz4" && p.compression != "bz2" && p.compression != "none") {
@@ -43,6 +45,8 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
   pnh.param("samples", p.samples, p.samples);
   if (p.samples < 0) badParameter("samples", text(p.samples), ">= 0 (0: no limit)");
   pnh.param<std::string>("answer_as", p.answer_as, p.answer_as);
+  pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
+  pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
   pnh.param("split_mb", p.split_mb, p.split_mb);
   if (!(p.split_mb >= 0.0)) badParameter("split_mb", text(p.split_mb), ">= 0 MB (0: one bag)");
   return p;
@@ -61,7 +65,7 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
   std::filesystem::remove(probe, ec);
   openNextBag();
 
-  answer_pub_ = nh_.advertise<FrameRendered>("contact_sim/rendered", 100, /*latch=*/true);
+  answer_pub_ = nh_.advertise<FrameRendered>(params_.answer_topic, 100, /*latch=*/true);
   std::vector<std::string> topics = params_.topics;
   for (const std::string& sensor : params_.sensors) {
     for (const char* leaf : {"/image_raw", "/camera_info", "/depth", "/contact"}) {
@@ -78,19 +82,49 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
         }));
   }
   episode_sub_ = nh_.subscribe("episode", 10, &DatasetRecorder::onEpisode, this);
-  frame_sub_ = nh_.subscribe("contact_sim/frame", 100, &DatasetRecorder::onFrame, this);
-  if (!params_.answer_as.empty()) {
-    FrameRendered ready;
-    ready.sensor = params_.answer_as;
-    ready.reason = "ready";
-    answer_pub_.publish(ready);
-  }
+  frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &DatasetRecorder::onFrame, this);
   started_ = last_progress_ = ros::WallTime::now();
+  if (!params_.answer_as.empty()) {
+    ready_timer_ = nh_.createWallTimer(ros::WallDuration(0.02),
+                                       [this](const ros::WallTimerEvent&) { announceReady(); });
+  }
   ROS_INFO("dataset_recorder: %zu topics -> %s (%s), target %d images", topics.size(),
            bag_paths_.back().c_str(), params_.compression.c_str(), params_.samples);
 }
 
 DatasetRecorder::~DatasetRecorder() { close(); }
+
+void DatasetRecorder::announceReady() {
+  // "Ready" only once the per-frame topics and the frames are connected: a synchronous source
+  // starts at that answer, and a message published before a connection exists is lost.
+  std::string unconnected;
+  const std::size_t extra = params_.topics.size();
+  for (std::size_t i = extra; i < subs_.size(); ++i) {
+    if (subs_[i].getNumPublishers() == 0) unconnected += " " + subs_[i].getTopic();
+  }
+  if (frame_sub_.getNumPublishers() == 0) unconnected += " " + frame_sub_.getTopic();
+  const ros::WallTime now = ros::WallTime::now();
+  if (!unconnected.empty()) {
+    ROS_INFO_THROTTLE(5.0, "dataset_recorder: waiting for publishers of%s", unconnected.c_str());
+    return;
+  }
+  // Extra topics (TF, clock, joints) may legitimately have no publisher: a short grace period.
+  if (connected_since_.isZero()) connected_since_ = now;
+  std::string optional;
+  for (std::size_t i = 0; i < extra; ++i) {
+    if (subs_[i].getNumPublishers() == 0) optional += " " + subs_[i].getTopic();
+  }
+  if (!optional.empty() && (now - connected_since_).toSec() < 1.0) return;
+  if (!optional.empty()) {
+    ROS_INFO("dataset_recorder: no publisher (yet) of%s; recording without waiting for them",
+             optional.c_str());
+  }
+  ready_timer_.stop();
+  FrameRendered ready;
+  ready.sensor = params_.answer_as;
+  ready.reason = "ready";
+  answer_pub_.publish(ready);
+}
 
 void DatasetRecorder::openNextBag() {
   if (bag_) bag_->close();
@@ -109,7 +143,17 @@ void DatasetRecorder::openNextBag() {
   bag_paths_.push_back(path);
 }
 
-void DatasetRecorder::onEpisode(const EpisodeInfo::ConstPtr& info) { episode_ = *info; }
+void DatasetRecorder::onEpisode(const EpisodeInfo::ConstPtr& info) {
+  episode_ = *info;
+  label_from_[info->header.stamp] = info->material + "/variant" + std::to_string(info->variant);
+  shards_.insert(info->shard);
+}
+
+std::string DatasetRecorder::labelAt(const ros::Time& stamp) const {
+  auto it = label_from_.upper_bound(stamp);
+  if (it == label_from_.begin()) return "unlabelled";
+  return std::prev(it)->second;
+}
 
 void DatasetRecorder::onMessage(const std::string& topic,
                                 const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
@@ -122,6 +166,7 @@ void DatasetRecorder::onMessage(const std::string& topic,
   } catch (const rosbag::BagException& ex) {
     error_ = std::string("writing ") + topic + " to " + bag_paths_.back() + " failed: " + ex.what();
     ROS_ERROR("dataset_recorder: %s; closing the bag", error_.c_str());
+    stop_reason_ = "error";
     done_ = true;
     return;
   }
@@ -139,13 +184,19 @@ void DatasetRecorder::onMessage(const std::string& topic,
   } else {
     frame_part = false;
   }
-  if (frame_part) ++parts_at_[stamp];
+  if (frame_part && ++parts_at_[stamp] >= 4 * static_cast<int>(params_.sensors.size())) {
+    parts_at_.erase(stamp);
+    completed_.insert(stamp);
+    // Remembered for a while: the frame's SimFrame may arrive after its last part.
+    if (completed_.size() > 10000) completed_.erase(completed_.begin());
+  }
   if (endsWith(topic, "/image_raw")) {
     ++images_;
-    ++images_per_label_[episode_.material + "/variant" + std::to_string(episode_.variant)];
+    ++images_per_label_[labelAt(stamp)];
     last_image_stamp_ = std::max(last_image_stamp_, stamp);
     if (params_.samples > 0 && images_ >= static_cast<std::uint64_t>(params_.samples)) {
       target_reached_ = true;
+      if (stop_reason_.empty()) stop_reason_ = "sample_target";
     }
     const ros::WallTime now = ros::WallTime::now();
     if ((now - last_progress_).toSec() >= 1.0) {
@@ -164,7 +215,7 @@ void DatasetRecorder::onMessage(const std::string& topic,
   if (target_reached_) {
     bool open_frames = false;
     for (const auto& [t, parts] : parts_at_) {
-      if (t <= last_image_stamp_ && !frameComplete(t)) open_frames = true;
+      if (t <= last_image_stamp_) open_frames = true;  // parts_at_ holds incomplete frames only
     }
     if (!open_frames) done_ = true;
   }
@@ -172,14 +223,15 @@ void DatasetRecorder::onMessage(const std::string& topic,
 }
 
 void DatasetRecorder::onFrame(const SimFrame::ConstPtr& frame) {
-  if (!frame->acknowledge || params_.answer_as.empty()) return;
-  waiting_[frame->header.stamp] = frame->frame;
+  if (frame->last) last_frame_stamp_ = frame->header.stamp;
+  if (frame->acknowledge && !params_.answer_as.empty()) {
+    waiting_[frame->header.stamp] = frame->frame;
+  }
   answerFramesWritten();
 }
 
 bool DatasetRecorder::frameComplete(const ros::Time& stamp) const {
-  const auto it = parts_at_.find(stamp);
-  return it != parts_at_.end() && it->second >= 4 * static_cast<int>(params_.sensors.size());
+  return completed_.count(stamp) > 0;
 }
 
 void DatasetRecorder::answerFramesWritten() {
@@ -198,16 +250,17 @@ void DatasetRecorder::answerFramesWritten() {
     answer_pub_.publish(answer);
     it = waiting_.erase(it);
   }
-  // Forget complete frames nobody waits for (real time).
-  for (auto it = parts_at_.begin(); it != parts_at_.end();) {
-    it = frameComplete(it->first) && !waiting_.count(it->first) ? parts_at_.erase(it)
-                                                                : std::next(it);
+  // The source's last frame written: stop (the answer above let the source finish).
+  if (!last_frame_stamp_.isZero() && frameComplete(last_frame_stamp_) && !done_) {
+    if (stop_reason_.empty()) stop_reason_ = "last_frame";
+    done_ = true;
   }
 }
 
-void DatasetRecorder::close() {
+void DatasetRecorder::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
+  if (stop_reason_.empty()) stop_reason_ = reason;
   if (bag_) bag_->close();  // writes the index: `rosbag info` reads it
   const std::string path = params_.output_dir + "/" + params_.prefix + "_shard" +
                            std::to_string(params_.shard) + ".yaml";
@@ -218,7 +271,17 @@ void DatasetRecorder::close() {
            << "compression: " << params_.compression << "\n"
            << "images: " << images_ << "\n"
            << "samples_wanted: " << params_.samples << "\n"
-           << "complete: " << (error_.empty() ? "true" : "false") << "\n";
+           << "stop_reason: " << stop_reason_ << "\n"
+           << "complete: "
+           << (error_.empty() && (stop_reason_ == "last_frame" || stop_reason_ == "sample_target")
+                   ? "true"
+                   : "false")
+           << "\n";
+  manifest << "shards_seen: [";
+  for (auto it = shards_.begin(); it != shards_.end(); ++it) {
+    manifest << (it == shards_.begin() ? "" : ", ") << *it;
+  }
+  manifest << "]\n";
   if (!error_.empty()) manifest << "error: \"" << error_ << "\"\n";
   manifest << "bags:\n";
   for (const std::string& bag : bag_paths_) {

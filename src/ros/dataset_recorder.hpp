@@ -30,6 +30,8 @@ struct DatasetRecorderParams {
   /// ~answer_as: the name it answers synchronous frames under (list it in contact_sim's
   /// ~renderers); "" = never answer.
   std::string answer_as = "recorder";
+  std::string frame_topic = "contact_sim/frame";      ///< ~frame_topic: the SimFrame source
+  std::string answer_topic = "contact_sim/rendered";  ///< ~answer_topic: where answers go
 };
 
 DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& private_nh);
@@ -46,10 +48,12 @@ class DatasetRecorder {
   DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh);
   ~DatasetRecorder();
 
-  /// True once the sample target is reached or a write failed (the node then exits).
+  /// True once the sample target or the source's last frame is written, or a write failed (the
+  /// node then exits).
   bool done() const { return done_; }
-  /// Closes the current bag and writes the manifest; idempotent.
-  void close();
+  /// Closes the current bag and writes the manifest; idempotent. `reason` says why it stopped
+  /// when it was not done by itself (e.g. "signal").
+  void close(const std::string& reason = "shutdown");
   /// Non-empty when writing failed (e.g. a full disk): why.
   const std::string& error() const { return error_; }
 
@@ -59,6 +63,10 @@ class DatasetRecorder {
   void onEpisode(const EpisodeInfo::ConstPtr& info);
   void openNextBag();
   void answerFramesWritten();
+  /// Publishes the "ready" answer once the topics of every frame are connected.
+  void announceReady();
+  /// "material/variant" of the episode an image stamped `stamp` belongs to.
+  std::string labelAt(const ros::Time& stamp) const;
   bool frameComplete(const ros::Time& stamp) const;
 
   DatasetRecorderParams params_;
@@ -66,13 +74,20 @@ class DatasetRecorder {
   std::vector<std::string> bag_paths_;
   std::map<std::string, std::uint64_t> received_, written_;
   /// Per frame stamp: messages written of the sensors' image_raw, camera_info, depth, contact;
-  /// a frame is complete at 4 per sensor.
+  /// a frame is complete at 4 per sensor, and then moves to completed_.
   std::map<ros::Time, int> parts_at_;
+  std::set<ros::Time> completed_;  ///< the latest 10000 complete frames
   ros::Time last_image_stamp_;
   bool target_reached_ = false;
   std::map<ros::Time, std::uint64_t> waiting_;  ///< synchronous frames to answer, by stamp
   std::map<std::string, std::uint64_t> images_per_label_;  ///< "material/variant" -> images
-  EpisodeInfo episode_;
+  EpisodeInfo episode_;  ///< the latest episode
+  /// Episodes by start stamp: an image belongs to the latest episode started at or before it
+  /// (topics arrive on separate connections, so arrival order is not enough).
+  std::map<ros::Time, std::string> label_from_;
+  std::set<std::uint32_t> shards_;
+  ros::Time last_frame_stamp_;  ///< the source's last frame, once announced
+  std::string stop_reason_;
   std::uint64_t images_ = 0;
   bool done_ = false, closed_ = false;
   std::string error_;
@@ -82,6 +97,8 @@ class DatasetRecorder {
   std::vector<ros::Subscriber> subs_;
   ros::Subscriber frame_sub_, episode_sub_;
   ros::Publisher answer_pub_;
+  ros::WallTimer ready_timer_;
+  ros::WallTime connected_since_;
 };
 
 }  // namespace norm2tex

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     while (ros::ok() && !g_stop && !recorder.done()) {
       ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
     }
-    recorder.close();
+    recorder.close(g_stop ? "signal" : "shutdown");
     ros::shutdown();
     if (!recorder.error().empty()) {
       std::cerr << "dataset_recorder: " << recorder.error() << std::endl;

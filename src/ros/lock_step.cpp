@@ -8,8 +8,11 @@
 namespace norm2tex {
 
 LockStep::LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> renderers,
-                   double timeout, std::string owner)
-    : renderers_(std::move(renderers)), timeout_(timeout), owner_(std::move(owner)) {
+                   double timeout, double ready_timeout, std::string owner)
+    : renderers_(std::move(renderers)),
+      timeout_(timeout),
+      ready_timeout_(ready_timeout),
+      owner_(std::move(owner)) {
   if (renderers_.empty()) return;
   ros::NodeHandle nh(private_nh);
   nh.setCallbackQueue(&queue_);
@@ -50,9 +53,9 @@ void LockStep::waitUntilReady() {
   if (!waits()) return;
   std::unique_lock<std::mutex> lock(mutex_);
   auto ready = [&] { return missing(nullptr).empty(); };
-  if (cv_.wait_for(lock, std::chrono::duration<double>(timeout_), ready)) return;
+  if (cv_.wait_for(lock, std::chrono::duration<double>(ready_timeout_), ready)) return;
   throw Error(owner_ + ": renderers" + missing(nullptr) +
-              " not ready within ~render_timeout = " + ros_params::text(timeout_) +
+              " not ready within ~ready_timeout = " + ros_params::text(ready_timeout_) +
               " s (are the tactile_renderer nodes running?)");
 }
 

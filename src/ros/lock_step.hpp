@@ -23,14 +23,15 @@ namespace norm2tex {
 class LockStep {
  public:
   /// `renderers`: names whose answers every frame waits for (empty: publish without waiting);
-  /// `timeout`: wall-clock seconds to wait for each answer; `owner`: the node's name, for errors.
+  /// `timeout`: wall-clock seconds to wait for each answer; `ready_timeout`: for the renderers
+  /// to become ready (they may bake textures first); `owner`: the node's name, for errors.
   LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> renderers, double timeout,
-           std::string owner);
+           double ready_timeout, std::string owner);
   ~LockStep();
 
   bool waits() const { return !renderers_.empty(); }
   /// Waits until every renderer has said it is ready (its latched first answer). Throws Error
-  /// naming the missing ones after the timeout.
+  /// naming the missing ones after the ready timeout.
   void waitUntilReady();
   /// Publishes `frame` and waits for every renderer's answer to it, offering it again every
   /// 0.2 s (a subscription still connecting misses a message; renderers answer a repeated frame
@@ -46,7 +47,7 @@ class LockStep {
   std::string missing(const SimFrame* frame) const;
 
   std::vector<std::string> renderers_;
-  double timeout_;
+  double timeout_, ready_timeout_;
   std::string owner_;
   ros::CallbackQueue queue_;
   ros::Subscriber sub_;

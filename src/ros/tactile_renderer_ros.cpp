@@ -1,5 +1,6 @@
 #include "tactile_renderer_ros.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -60,6 +61,10 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   }
   pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
   pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
+  pnh.param("texture_from_frame", p.texture_from_frame, p.texture_from_frame);
+  if (p.texture_from_frame && p.material.empty()) {
+    badParameter("texture_from_frame", "true", "false with ~normal_map or ~atlas (frames name materials)");
+  }
   return p;
 }
 
@@ -80,7 +85,7 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
     mesh_spec = scene.object.mesh;
     scale = scene.object.scale;
   }
-  auto mesh = std::make_shared<TexturedMesh>(loadObjectMesh(mesh_spec, scale).mesh);
+  mesh_ = std::make_shared<TexturedMesh>(loadObjectMesh(mesh_spec, scale).mesh);
   TextureSource source;
   source.material_config = params_.material_config;
   source.variant = params_.variant;
@@ -89,25 +94,22 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   source.convention = parseNormalConvention(params_.convention);
   source.atlas = params_.atlas;
   ROS_INFO("%s: preparing the texture of %s ...", params_.sensor_name.c_str(), mesh_spec.c_str());
-  const ros::WallTime start = ros::WallTime::now();
-  const ObjectTexture texture = loadObjectTexture(source, *mesh);
-  if (!texture.warning.empty())
-    ROS_WARN("%s: %s", params_.sensor_name.c_str(), texture.warning.c_str());
-  const double beta = params_.beta >= 0.0     ? params_.beta
-                      : texture.beta_mm > 0.0 ? texture.beta_mm
-                                              : 0.1;
-  const std::string warning = renderer_->setObject(mesh, texture.atlas, texture.atlas ? beta : 0.0);
-  if (!warning.empty()) ROS_WARN("%s: %s", params_.sensor_name.c_str(), warning.c_str());
-  ROS_INFO("%s: %s, beta %.3f mm, ready in %.2f s; rendering %s in %s on %s",
-           params_.sensor_name.c_str(), texture.atlas ? texture.description.c_str() : "no texture",
-           texture.atlas ? beta : 0.0, (ros::WallTime::now() - start).toSec(),
-           params_.object_frame.c_str(), params_.gel_frame.c_str(), params_.frame_topic.c_str());
+  useTexture(source, params_.material + "/" + std::to_string(params_.variant));
+  ROS_INFO("%s: rendering %s in %s on %s%s", params_.sensor_name.c_str(),
+           params_.object_frame.c_str(), params_.gel_frame.c_str(), params_.frame_topic.c_str(),
+           params_.texture_from_frame ? ", texture as each frame names it" : "");
 
   const std::string& ns = params_.sensor_name;
   image_pub_ = it_.advertise(ns + "/image_raw", 10);
   info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>(ns + "/camera_info", 10);
   depth_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/depth", 10);
   if (params_.publish_mask) mask_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/contact_mask", 10);
+  // The no-contact frame (without noise), latched: what background-subtracted datasets subtract.
+  background_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/background", 1, /*latch=*/true);
+  std_msgs::Header background_header;
+  background_header.frame_id = params_.gel_frame;
+  background_pub_.publish(
+      ros_conversions::toImageMsg(background_header, renderer_->shader().background()));
   // Frames in order, none dropped by the subscriber: synchronous mode sends one at a time, real
   // time at most a few behind. The answer topic comes last: contact_sim takes it as "ready".
   frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &TactileRendererRos::onFrame, this);
@@ -118,6 +120,43 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   ready.sensor = params_.sensor_name;
   ready.reason = "ready";
   rendered_pub_.publish(ready);
+}
+
+void TactileRendererRos::useTexture(const TextureSource& source, const std::string& key) {
+  constexpr std::size_t kCachedTextures = 6;
+  auto cached = std::find_if(texture_cache_.begin(), texture_cache_.end(),
+                             [&](const auto& entry) { return entry.first == key; });
+  const ros::WallTime start = ros::WallTime::now();
+  if (cached == texture_cache_.end()) {
+    ObjectTexture texture = loadObjectTexture(source, *mesh_);
+    if (!texture.warning.empty()) {
+      ROS_WARN("%s: %s", params_.sensor_name.c_str(), texture.warning.c_str());
+    }
+    texture_cache_.emplace_front(key, std::move(texture));
+    if (texture_cache_.size() > kCachedTextures) texture_cache_.pop_back();
+  } else {
+    texture_cache_.splice(texture_cache_.begin(), texture_cache_, cached);
+  }
+  const ObjectTexture& texture = texture_cache_.front().second;
+  const double beta = params_.beta >= 0.0     ? params_.beta
+                      : texture.beta_mm > 0.0 ? texture.beta_mm
+                                              : 0.1;
+  const std::string warning = renderer_->setObject(mesh_, texture.atlas, texture.atlas ? beta : 0.0);
+  if (!warning.empty()) ROS_WARN("%s: %s", params_.sensor_name.c_str(), warning.c_str());
+  texture_key_ = key;
+  ROS_INFO("%s: %s, beta %.3f mm, ready in %.2f s", params_.sensor_name.c_str(),
+           texture.atlas ? texture.description.c_str() : "no texture", texture.atlas ? beta : 0.0,
+           (ros::WallTime::now() - start).toSec());
+}
+
+void TactileRendererRos::followFrameTexture(const SimFrame& frame) {
+  const std::string key = frame.material + "/" + std::to_string(frame.variant);
+  if (key == texture_key_) return;
+  TextureSource source;
+  source.material_config = ros_params::materialConfigPath(frame.material);
+  source.variant = static_cast<int>(frame.variant);
+  source.seed = static_cast<std::uint64_t>(params_.material_seed);
+  useTexture(source, key);
 }
 
 bool TactileRendererRos::anyoneListens() const {
@@ -139,6 +178,7 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   answer.sensor = params_.sensor_name;
   answer.frame = frame->frame;
   try {
+    if (params_.texture_from_frame) followFrameTexture(*frame);
     // The pose at exactly this stamp: wait (wall clock: simulated time may stand still) for TF,
     // never extrapolate or take a stale pose.
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.tf_timeout);

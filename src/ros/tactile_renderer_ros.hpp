@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <list>
 #include <memory>
 #include <string>
 
@@ -11,6 +12,7 @@
 
 #include "norm2tex/FrameRendered.h"
 #include "norm2tex/SimFrame.h"
+#include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
 
 namespace norm2tex {
@@ -38,6 +40,9 @@ struct TactileRendererParams {
   double tf_timeout = 1.0;    ///< ~tf_timeout [s of wall time] for the pose at a frame's stamp
   std::string frame_topic = "contact_sim/frame";      ///< ~frame_topic: SimFrame source
   std::string answer_topic = "contact_sim/rendered";  ///< ~answer_topic: FrameRendered sink
+  /// ~texture_from_frame: render each frame with the material and variant its SimFrame names
+  /// (probe datasets step through every variant); ~material and ~variant give the first one.
+  bool texture_from_frame = false;
 };
 
 TactileRendererParams readTactileRendererParams(const ros::NodeHandle& private_nh);
@@ -56,9 +61,17 @@ class TactileRendererRos {
  private:
   void onFrame(const SimFrame::ConstPtr& frame);
   bool anyoneListens() const;
+  /// Loads (or takes from the cache) a texture and gives it to the renderer.
+  void useTexture(const TextureSource& source, const std::string& key);
+  /// ~texture_from_frame: switches to the frame's material and variant if they differ.
+  void followFrameTexture(const SimFrame& frame);
 
   TactileRendererParams params_;
   std::unique_ptr<TactileRenderer> renderer_;
+  std::shared_ptr<TexturedMesh> mesh_;
+  std::string texture_key_;  ///< "material/variant" (or the file) being rendered
+  /// The latest textures, most recent first: a dataset revisits few, and each is megabytes.
+  std::list<std::pair<std::string, ObjectTexture>> texture_cache_;
   std::uint64_t rendered_ = 0, missed_ = 0;
   bool answered_any_ = false;
   FrameRendered last_answer_;  ///< repeated when contact_sim offers the same frame again
@@ -68,7 +81,7 @@ class TactileRendererRos {
   tf2_ros::TransformListener tf_listener_;
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
-  ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_;
+  ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;
   ros::Subscriber frame_sub_;
 };
 

@@ -6,6 +6,7 @@
 #include "conversions.hpp"
 #include "markers.hpp"
 #include "norm2tex/common/error.hpp"
+#include "../core/test_helpers.hpp"
 
 namespace norm2tex {
 namespace {
@@ -86,6 +87,36 @@ TEST(ConversionsTest, ImagesKeepTheirPixelsAndEncodings) {
   EXPECT_EQ(first, 1.5f);
   EXPECT_EQ(ros_conversions::toImageMsg(header, cv::Mat1b(2, 2))->encoding, "mono8");
   EXPECT_THROW(ros_conversions::toImageMsg(header, cv::Mat1d(2, 2)), Error);
+}
+
+TEST(ConversionsTest, ImageMessagesComeBackAsTheSamePixels) {
+  std_msgs::Header header;
+  cv::Mat3b image(320, 240, cv::Vec3b(1, 2, 3));
+  image(5, 7) = cv::Vec3b(10, 20, 30);
+  const cv::Mat back = ros_conversions::fromImageMsg(*ros_conversions::toImageMsg(header, image));
+  ASSERT_EQ(back.type(), CV_8UC3);
+  EXPECT_EQ(cv::norm(back, image, cv::NORM_INF), 0.0);
+  cv::Mat1f depth(4, 3, 0.25f);
+  depth(3, 2) = -1.0f;
+  const cv::Mat depth_back =
+      ros_conversions::fromImageMsg(*ros_conversions::toImageMsg(header, depth));
+  EXPECT_EQ(cv::norm(depth_back, depth, cv::NORM_INF), 0.0);
+  // rgb8 (other drivers) arrives as BGR; padded rows (step > width) are unpadded.
+  sensor_msgs::Image rgb;
+  rgb.encoding = "rgb8";
+  rgb.width = 2;
+  rgb.height = 1;
+  rgb.step = 8;
+  rgb.data = {10, 20, 30, 40, 50, 60, 0, 0};
+  const cv::Mat3b bgr = ros_conversions::fromImageMsg(rgb);
+  EXPECT_EQ(bgr(0, 0), cv::Vec3b(30, 20, 10));
+  EXPECT_EQ(bgr(0, 1), cv::Vec3b(60, 50, 40));
+  // Odd encodings and truncated data are errors that say so.
+  rgb.encoding = "bayer_rggb8";
+  test::expectError([&] { ros_conversions::fromImageMsg(rgb); }, {"bayer_rggb8", "bgr8"});
+  rgb.encoding = "rgb8";
+  rgb.data.resize(5);
+  test::expectError([&] { ros_conversions::fromImageMsg(rgb); }, {"truncated"});
 }
 
 TEST(ConversionsTest, CameraInfoCarriesTheSensorIntrinsics) {

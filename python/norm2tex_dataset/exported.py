@@ -1,0 +1,84 @@
+"""The layout norm2tex_export writes, as a map-style torch Dataset."""
+
+import csv
+import os
+
+import numpy as np
+import torch
+from PIL import Image
+
+_NUMERIC = {
+    "variant": int, "stamp": int, "episode": int, "beta": float, "seed": int, "shard": int,
+    "press": int, "press_depth": float, "in_contact": int, "normal_force": float,
+    "max_indentation": float, "contact_area": float,
+}
+
+
+def _read_png(path):
+    """H x W x C (or H x W) numpy array of a PNG, keeping its bit depth."""
+    with Image.open(path) as image:
+        array = np.array(image)
+    if array.ndim == 3:
+        array = array[:, :, ::-1]  # PIL gives RGB; the sensor's images are BGR
+    return array
+
+
+class ExportedDataset(torch.utils.data.Dataset):
+    """Frames exported by norm2tex_export.
+
+    root: the export directory (with labels.csv).
+    image: "diff" (image - background, float grey levels, 0 where nothing touches),
+        "raw" (the sensor image, 0..255) or "depth" (gel indentation in millimetres).
+    materials, variants, sensors: keep only these (None: all). Holding variants out
+        is how the paper tests generalisation to unseen textures.
+    transform: applied to the image tensor.
+    return_labels: the target is a dict of every label instead of the class index.
+    """
+
+    def __init__(self, root, image="diff", materials=None, variants=None, sensors=None,
+                 transform=None, return_labels=False):
+        if image not in ("diff", "raw", "depth"):
+            raise ValueError(f"image must be diff, raw or depth, not {image!r}")
+        labels = os.path.join(root, "labels.csv")
+        if not os.path.isfile(labels):
+            raise FileNotFoundError(f"{labels} not found: is {root!r} a norm2tex_export directory?")
+        self.root, self.image, self.transform = root, image, transform
+        self.return_labels = return_labels
+        with open(labels, newline="") as f:
+            rows = list(csv.DictReader(f))
+        for row in rows:
+            for key, kind in _NUMERIC.items():
+                if key in row and row[key] not in ("", "nan"):
+                    row[key] = kind(float(row[key])) if kind is int else kind(row[key])
+        self.rows = [r for r in rows
+                     if (materials is None or r["material"] in materials)
+                     and (variants is None or r["variant"] in variants)
+                     and (sensors is None or r["sensor"] in sensors)]
+        if image == "depth" and any(not r["depth"] for r in self.rows):
+            raise ValueError("image='depth' but some frames were exported without depth")
+        self.classes = sorted({r["material"] for r in rows})
+        self.class_to_idx = {c: i for i, c in enumerate(self.classes)}
+
+    def __len__(self):
+        return len(self.rows)
+
+    def __getitem__(self, index):
+        row = self.rows[index]
+        path = os.path.join(self.root, row[self.image])
+        if self.image == "depth":
+            if path.endswith(".tiff"):
+                with Image.open(path) as tiff:
+                    array = np.array(tiff, dtype=np.float32) * 1000.0  # metres -> mm
+            else:
+                array = _read_png(path).astype(np.float32) / 1000.0  # micrometres -> mm
+            tensor = torch.from_numpy(array)[None]
+        else:
+            array = _read_png(path).astype(np.float32)
+            if self.image == "diff":
+                array -= 128.0  # stored as image - background + 128
+            tensor = torch.from_numpy(np.ascontiguousarray(array.transpose(2, 0, 1)))
+        if self.transform is not None:
+            tensor = self.transform(tensor)
+        if self.return_labels:
+            return tensor, dict(row)
+        return tensor, self.class_to_idx[row["material"]]
