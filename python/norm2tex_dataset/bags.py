@@ -66,20 +66,26 @@ class BagDataset(torch.utils.data.IterableDataset):
         self.classes = list(classes)
         self.class_to_idx = {c: i for i, c in enumerate(self.classes)}
 
+    def _episodes(self):
+        """Every episode label, sorted by stamp (read first: an episode message may be stored
+        after frames of its episode)."""
+        by_stamp = {}
+        for path in self.bags:
+            with self._rosbag.Bag(path) as bag:
+                for _, msg, _ in bag.read_messages(topics=["/episode"]):
+                    by_stamp[msg.header.stamp.to_nsec()] = msg
+        stamps = sorted(by_stamp)
+        return [by_stamp[s] for s in stamps], stamps
+
     def __iter__(self):
-        episodes, episode_stamps = [], []  # sorted by start stamp
+        episodes, episode_stamps = self._episodes()
         backgrounds = {}
         pending = {}  # (sensor, stamp) -> {"image": ..., "contact": ...}
         for path in self.bags:
             with self._rosbag.Bag(path) as bag:
                 for topic, msg, _ in bag.read_messages():
                     sensor, leaf = _split(topic)
-                    if leaf == "episode":
-                        stamp = msg.header.stamp.to_nsec()
-                        i = bisect.bisect_right(episode_stamps, stamp)
-                        episode_stamps.insert(i, stamp)
-                        episodes.insert(i, msg)
-                    elif leaf == "background":
+                    if leaf == "background":
                         backgrounds[sensor] = _image_array(msg).astype(np.float32)
                     elif leaf in ("image_raw", "contact"):
                         key = (sensor, msg.header.stamp.to_nsec())

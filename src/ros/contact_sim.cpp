@@ -356,7 +356,7 @@ std::uint32_t ContactSim::publishFrame() {
   frame.material = params_.material;
   frame.variant = static_cast<std::uint32_t>(params_.variant);
   // Lock-step: every renderer answers this frame before the next one is simulated.
-  return lock_step_->publishAndWait(frame_pub_, frame);
+  return lock_step_->publish(frame_pub_, frame);
 }
 
 }  // namespace norm2tex

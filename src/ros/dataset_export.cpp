@@ -20,7 +20,8 @@ void writeImage(const fs::path& path, const cv::Mat& image) {
   fs::create_directories(path.parent_path());
   bool ok = false;
   try {
-    ok = cv::imwrite(path.string(), image);
+    // Fast deflate: level 1 files are ~10 % larger than the default 3 and written ~2x faster.
+    ok = cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 1});
   } catch (const cv::Exception& e) {
     throw Error("writing '" + path.string() + "' failed: " + e.what());
   }

@@ -8,16 +8,17 @@
 namespace norm2tex {
 
 LockStep::LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> renderers,
-                   double timeout, double ready_timeout, std::string owner)
+                   double timeout, double ready_timeout, std::string owner, int window)
     : renderers_(std::move(renderers)),
       timeout_(timeout),
       ready_timeout_(ready_timeout),
-      owner_(std::move(owner)) {
+      owner_(std::move(owner)),
+      window_(static_cast<std::size_t>(std::max(1, window))) {
   if (renderers_.empty()) return;
   ros::NodeHandle nh(private_nh);
   nh.setCallbackQueue(&queue_);
   // One topic for every renderer's answers: answers name their sensor.
-  sub_ = nh.subscribe("rendered", 100, &LockStep::onRendered, this);
+  sub_ = nh.subscribe("rendered", 1000, &LockStep::onRendered, this);
   spinner_ = std::make_unique<ros::AsyncSpinner>(1, &queue_);
   spinner_->start();
 }
@@ -29,22 +30,33 @@ LockStep::~LockStep() {
 void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    last_[msg->sensor] = *msg;  // a renderer's first message (latched) says it is ready
+    ready_.insert(msg->sensor);  // a renderer's first message (latched) says it is ready
+    const auto it = in_flight_.find(msg->frame);
+    if (it != in_flight_.end() && it->second.frame.header.stamp == msg->header.stamp &&
+        it->second.answered.insert(msg->sensor).second) {
+      ++answers_;
+      if (!msg->published) {
+        ++missing_images_;
+        ROS_WARN("%s: %s published no image for frame %lu: %s", owner_.c_str(),
+                 msg->sensor.c_str(), static_cast<unsigned long>(msg->frame),
+                 msg->reason.c_str());
+      }
+      // Frames leave in order once everyone has answered them.
+      while (!in_flight_.empty() && in_flight_.begin()->second.answered.size() >= renderers_.size()) {
+        bool all = true;
+        for (const std::string& r : renderers_) all = all && in_flight_.begin()->second.answered.count(r);
+        if (!all) break;
+        in_flight_.erase(in_flight_.begin());
+      }
+    }
   }
   cv_.notify_all();
 }
 
-bool LockStep::hasAnswered(const std::string& sensor, const SimFrame* frame) const {
-  const auto it = last_.find(sensor);
-  if (it == last_.end()) return false;
-  return frame == nullptr ||
-         (it->second.frame == frame->frame && it->second.header.stamp == frame->header.stamp);
-}
-
-std::string LockStep::missing(const SimFrame* frame) const {
+std::string LockStep::notReady() const {
   std::string names;
   for (const std::string& sensor : renderers_) {
-    if (!hasAnswered(sensor, frame)) names += " " + sensor;
+    if (!ready_.count(sensor)) names += " " + sensor;
   }
   return names;
 }
@@ -52,43 +64,62 @@ std::string LockStep::missing(const SimFrame* frame) const {
 void LockStep::waitUntilReady() {
   if (!waits()) return;
   std::unique_lock<std::mutex> lock(mutex_);
-  auto ready = [&] { return missing(nullptr).empty(); };
+  auto ready = [&] { return notReady().empty(); };
   if (cv_.wait_for(lock, std::chrono::duration<double>(ready_timeout_), ready)) return;
-  throw Error(owner_ + ": renderers" + missing(nullptr) +
-              " not ready within ~ready_timeout = " + ros_params::text(ready_timeout_) +
+  throw Error(owner_ + ": renderers" + notReady() + " not ready within ~ready_timeout = " +
+              ros_params::text(ready_timeout_) +
               " s (are the tactile_renderer nodes running?)");
 }
 
-std::uint32_t LockStep::publishAndWait(const ros::Publisher& frame_pub, const SimFrame& frame) {
+std::uint32_t LockStep::waitForAnswers(std::unique_lock<std::mutex>& lock,
+                                       const ros::Publisher& pub, std::size_t limit) {
+  auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_);
+  std::uint64_t seen = answers_;
+  while (in_flight_.size() > limit) {
+    if (cv_.wait_for(lock, std::chrono::milliseconds(200),
+                     [&] { return in_flight_.size() <= limit; })) {
+      break;
+    }
+    if (!ros::ok()) throw Error(owner_ + ": shutting down");
+    if (answers_ != seen) {  // progress: the timeout counts from the latest answer
+      seen = answers_;
+      deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_);
+    } else if (std::chrono::steady_clock::now() > deadline) {
+      std::string missing;
+      const InFlight& oldest = in_flight_.begin()->second;
+      for (const std::string& r : renderers_) {
+        if (!oldest.answered.count(r)) missing += " " + r;
+      }
+      throw Error("no answer from" + missing + " to frame " +
+                  std::to_string(oldest.frame.frame) + " within ~render_timeout = " +
+                  ros_params::text(timeout_) + " s");
+    }
+    for (const auto& [number, f] : in_flight_) pub.publish(f.frame);  // offer them again
+  }
+  const std::uint32_t missing = missing_images_;
+  missing_images_ = 0;
+  return missing;
+}
+
+std::uint32_t LockStep::publish(const ros::Publisher& frame_pub, const SimFrame& frame) {
   if (!waits()) {
     frame_pub.publish(frame);
     return 0;
   }
   waitUntilReady();
-  frame_pub.publish(frame);
   std::unique_lock<std::mutex> lock(mutex_);
-  auto all_answered = [&] { return missing(&frame).empty(); };
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_);
-  bool all = false;
-  while (!(all = cv_.wait_for(lock, std::chrono::milliseconds(200), all_answered)) &&
-         std::chrono::steady_clock::now() < deadline && ros::ok()) {
-    frame_pub.publish(frame);
-  }
-  if (!all) {
-    throw Error("no answer from" + missing(&frame) +
-                " within ~render_timeout = " + ros_params::text(timeout_) + " s");
-  }
-  std::uint32_t missing_images = 0;
-  for (const std::string& sensor : renderers_) {
-    const FrameRendered& answer = last_.at(sensor);
-    if (!answer.published) {
-      ++missing_images;
-      ROS_WARN("%s: %s published no image for frame %lu: %s", owner_.c_str(), sensor.c_str(),
-               static_cast<unsigned long>(frame.frame), answer.reason.c_str());
-    }
-  }
-  return missing_images;
+  std::uint32_t missing = waitForAnswers(lock, frame_pub, window_ - 1);
+  in_flight_[frame.frame] = InFlight{frame, {}};
+  frame_pub.publish(frame);
+  if (window_ == 1) missing += waitForAnswers(lock, frame_pub, 0);
+  return missing;
+}
+
+std::uint32_t LockStep::drain(const ros::Publisher& frame_pub) {
+  if (!waits()) return 0;
+  std::unique_lock<std::mutex> lock(mutex_);
+  return waitForAnswers(lock, frame_pub, 0);
 }
 
 }  // namespace norm2tex

@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -16,45 +17,62 @@
 
 namespace norm2tex {
 
-/// Synchronous frames for a frame source (contact_sim, probe_sim): publish a SimFrame, then wait
-/// until every listed renderer (or recorder) has answered it on ~rendered (FrameRendered), so
-/// nothing downstream is skipped or raced. Answers arrive on a queue and thread of their own:
-/// the waiting caller may hold the thread a nodelet manager would deliver them on.
+/// Synchronous frames for a frame source (contact_sim, probe_sim): publish a SimFrame, and have
+/// every listed renderer (or recorder) answer it on ~rendered (FrameRendered), so nothing
+/// downstream is skipped or raced. Up to `window` frames may be in flight (published, not yet
+/// answered by everyone): 1 is strict lock-step (a policy reads the images of a frame before the
+/// next), more lets the source, the renderers and a recorder work on consecutive frames at once
+/// (a dataset: still nothing lost, drain() waits for the rest). Answers arrive on a queue and
+/// thread of their own: the waiting caller may hold the thread a nodelet manager would deliver
+/// them on.
 class LockStep {
  public:
   /// `renderers`: names whose answers every frame waits for (empty: publish without waiting);
-  /// `timeout`: wall-clock seconds to wait for each answer; `ready_timeout`: for the renderers
-  /// to become ready (they may bake textures first); `owner`: the node's name, for errors.
+  /// `timeout`: wall-clock seconds without any answer before giving up; `ready_timeout`: for the
+  /// renderers to become ready (they may bake textures first); `owner`: the node's name.
   LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> renderers, double timeout,
-           double ready_timeout, std::string owner);
+           double ready_timeout, std::string owner, int window = 1);
   ~LockStep();
 
   bool waits() const { return !renderers_.empty(); }
   /// Waits until every renderer has said it is ready (its latched first answer). Throws Error
   /// naming the missing ones after the ready timeout.
   void waitUntilReady();
-  /// Publishes `frame` and waits for every renderer's answer to it, offering it again every
-  /// 0.2 s (a subscription still connecting misses a message; renderers answer a repeated frame
-  /// without rendering it twice). Returns how many renderers published no image for it (each is
-  /// warned about). Throws Error naming the renderers that did not answer in time.
-  std::uint32_t publishAndWait(const ros::Publisher& frame_pub, const SimFrame& frame);
+  /// Publishes `frame` once fewer than `window` frames are in flight; with window 1 returns only
+  /// when every renderer has answered it. Frames must come in increasing frame numbers. Returns
+  /// how many images the renderers reported missing (each is warned about) among the frames
+  /// answered meanwhile. Throws Error naming the renderers that did not answer in time.
+  std::uint32_t publish(const ros::Publisher& frame_pub, const SimFrame& frame);
+  /// Waits until every frame in flight is answered; returns missing images as publish() does.
+  std::uint32_t drain(const ros::Publisher& frame_pub);
 
  private:
+  struct InFlight {
+    SimFrame frame;
+    std::set<std::string> answered;
+  };
   void onRendered(const FrameRendered::ConstPtr& msg);
-  /// Has `sensor` answered `frame` (null: said anything, i.e. is ready)? Call with mutex_ held.
-  bool hasAnswered(const std::string& sensor, const SimFrame* frame) const;
-  /// " name name": the renderers that have not answered `frame`. Call with mutex_ held.
-  std::string missing(const SimFrame* frame) const;
+  /// Waits (mutex_ held through `lock`) until at most `limit` frames are in flight; offers the
+  /// unanswered ones again every 0.2 s without progress (a subscription still connecting misses
+  /// a message; renderers answer a repeated frame without rendering it twice).
+  std::uint32_t waitForAnswers(std::unique_lock<std::mutex>& lock, const ros::Publisher& pub,
+                               std::size_t limit);
+  /// " name name": renderers that have not said they are ready. Call with mutex_ held.
+  std::string notReady() const;
 
   std::vector<std::string> renderers_;
   double timeout_, ready_timeout_;
   std::string owner_;
+  std::size_t window_;
   ros::CallbackQueue queue_;
   ros::Subscriber sub_;
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::map<std::string, FrameRendered> last_;  ///< latest answer of each renderer
-  std::unique_ptr<ros::AsyncSpinner> spinner_;  // last: stopped first
+  std::set<std::string> ready_;
+  std::map<std::uint64_t, InFlight> in_flight_;  ///< by frame number
+  std::uint32_t missing_images_ = 0;             ///< reported since the last publish/drain
+  std::uint64_t answers_ = 0;                    ///< answers to frames in flight, ever
+  std::unique_ptr<ros::AsyncSpinner> spinner_;   // last: stopped first
 };
 
 }  // namespace norm2tex

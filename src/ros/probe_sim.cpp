@@ -109,6 +109,8 @@ ProbeSimParams readProbeSimParams(const ros::NodeHandle& pnh) {
     badParameter("ready_timeout", text(p.ready_timeout), "(0, 3600] s");
   }
   pnh.param("autostart", p.autostart, p.autostart);
+  pnh.param("window", p.window, p.window);
+  if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
   return p;
 }
 
@@ -153,7 +155,7 @@ ProbeSim::ProbeSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);
   marker_pub_.publish(ros_conversions::objectMarker(object_.mesh, ros::Time(0)));
   lock_step_ = std::make_unique<LockStep>(private_nh_, params_.renderers, params_.render_timeout,
-                                          params_.ready_timeout, "probe_sim");
+                                          params_.ready_timeout, "probe_sim", params_.window);
   ros::NodeHandle service_nh(private_nh_);
   service_nh.setCallbackQueue(&service_queue_);
   if (!params_.autostart) step_srv_ = service_nh.advertiseService("step", &ProbeSim::onStep, this);
@@ -213,6 +215,14 @@ bool ProbeSim::onStep(Step::Request& request, Step::Response& response) {
         return false;
       }
     }
+  } catch (const Error& e) {
+    ROS_ERROR("probe_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
+    return false;
+  }
+  try {
+    const std::uint32_t missing = lock_step_->drain(frame_pub_);
+    response.missing_images += missing;
+    missing_images_ += missing;
   } catch (const Error& e) {
     ROS_ERROR("probe_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
     return false;
@@ -294,11 +304,14 @@ bool ProbeSim::advanceFrame() {
   frame.variant = static_cast<std::uint32_t>(block.variant);
   frame.last = next_press_ == schedule_->presses().size() && next_in_press_ == press_frames_.size();
   ++frame_;
-  lock_step_->publishAndWait(frame_pub_, frame);
+  missing_images_ += lock_step_->publish(frame_pub_, frame);
   if (frame.last) {
+    missing_images_ += lock_step_->drain(frame_pub_);
     const double seconds = (ros::WallTime::now() - started_).toSec();
-    ROS_INFO("probe_sim: done, %ld frames of %zu presses in %.1f s (%.0f frames/s)",
-             static_cast<long>(frame_), schedule_->presses().size(), seconds, frame_ / seconds);
+    ROS_INFO("probe_sim: done, %ld frames of %zu presses in %.1f s (%.0f frames/s), %lu images "
+             "missing",
+             static_cast<long>(frame_), schedule_->presses().size(), seconds, frame_ / seconds,
+             static_cast<unsigned long>(missing_images_));
   }
   return true;
 }

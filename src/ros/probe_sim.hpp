@@ -44,6 +44,8 @@ struct ProbeSimParams {
   /// ~ready_timeout [s of wall time] for the renderers to start (texture bakes included)
   double ready_timeout = 60.0;
   bool autostart = true;  ///< ~autostart: run the whole schedule at once; false: ~step drives it
+  /// ~window: frames in flight at once (1 = strict lock-step); every frame is still answered.
+  int window = 4;
 };
 
 /// Reads and validates the private parameters; throws Error naming the parameter at fault.
@@ -86,6 +88,7 @@ class ProbeSim {
   std::size_t next_in_press_ = 0;
   std::int64_t frame_ = 0, period_ns_ = 0;
   std::uint32_t episode_ = 0;
+  std::uint64_t missing_images_ = 0;  ///< frames a renderer reported without an image
   ros::WallTime started_;
 
   std::mutex mutex_;

@@ -54,7 +54,17 @@ std::uint64_t TactileBagReader::forEachSample(
       if (leaf == "image_raw" || leaf == "depth" || leaf == "contact") leaves[sensor].insert(leaf);
     }
   }
+  // Every episode label first (a small topic, read through the bag index): an episode message
+  // may be stored after frames of its episode (a pipelined source runs the clock ahead), so
+  // labels are joined by stamp, not by the order in the bag.
   std::map<ros::Time, EpisodeInfo> episodes;
+  for (const std::string& path : paths_) {
+    rosbag::Bag bag(path, rosbag::bagmode::Read);
+    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/episode", "episode"}));
+    for (const rosbag::MessageInstance& m : view) {
+      if (auto info = m.instantiate<EpisodeInfo>()) episodes[info->header.stamp] = *info;
+    }
+  }
   std::map<std::pair<std::string, ros::Time>, Partial> pending;
   std::uint64_t count = 0;
   auto episodeAt = [&](const ros::Time& stamp) {
@@ -66,8 +76,8 @@ std::uint64_t TactileBagReader::forEachSample(
     return p.has_image && (p.has_depth || !has.count("depth")) &&
            (p.sample.has_contact || !has.count("contact"));
   };
-  // Complete frames wait until the bag's time has passed their stamp: messages of equal bag
-  // time (an episode label and its first frame) may be stored in either order.
+  // Complete frames are handed over in stamp order: a pipelined source's frames may complete
+  // out of order by a few; hold them until the bag's time has passed their stamp.
   std::map<std::pair<ros::Time, std::string>, TactileSample> ready;
   auto emitReady = [&](const ros::Time* before) {
     while (!ready.empty() && (!before || ready.begin()->first.first < *before)) {
@@ -85,10 +95,7 @@ std::uint64_t TactileBagReader::forEachSample(
       const ros::Time bag_time = m.getTime();
       emitReady(&bag_time);
       const auto [sensor, leaf] = splitTopic(m.getTopic());
-      if (leaf == "episode") {
-        if (auto info = m.instantiate<EpisodeInfo>()) episodes[info->header.stamp] = *info;
-        continue;
-      }
+      if (leaf == "episode") continue;  // read above
       if (leaf == "background") {
         if (auto image = m.instantiate<sensor_msgs::Image>()) {
           backgrounds_[sensor] = ros_conversions::fromImageMsg(*image);

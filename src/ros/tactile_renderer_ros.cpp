@@ -167,9 +167,13 @@ bool TactileRendererRos::anyoneListens() const {
 void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   // Real time: skip the work when nobody listens. Synchronous: every frame is rendered.
   if (!frame->acknowledge && !anyoneListens()) return;
-  if (frame->acknowledge && answered_any_ && last_answer_.frame == frame->frame &&
-      last_answer_.header.stamp == frame->header.stamp) {
-    rendered_pub_.publish(last_answer_);  // offered again: answer again, render once
+  if (frame->acknowledge && answered_any_ && frame->frame <= last_answered_frame_) {
+    // Offered again (a source re-offers frames it has no answer to from everyone): answer
+    // again, never render twice; a frame older than the answers kept is ignored.
+    const auto it = recent_answers_.find(frame->frame);
+    if (it != recent_answers_.end() && it->second.header.stamp == frame->header.stamp) {
+      rendered_pub_.publish(it->second);
+    }
     return;
   }
   FrameRendered answer;
@@ -231,7 +235,9 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   }
   if (frame->acknowledge) {
     rendered_pub_.publish(answer);
-    last_answer_ = answer;
+    recent_answers_[answer.frame] = answer;
+    if (recent_answers_.size() > 256) recent_answers_.erase(recent_answers_.begin());
+    last_answered_frame_ = answer.frame;
     answered_any_ = true;
   }
 }

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <list>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -74,7 +75,9 @@ class TactileRendererRos {
   std::list<std::pair<std::string, ObjectTexture>> texture_cache_;
   std::uint64_t rendered_ = 0, missed_ = 0;
   bool answered_any_ = false;
-  FrameRendered last_answer_;  ///< repeated when contact_sim offers the same frame again
+  std::uint64_t last_answered_frame_ = 0;
+  /// The latest answers by frame: repeated when a source offers one of these frames again.
+  std::map<std::uint64_t, FrameRendered> recent_answers_;
 
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_buffer_;

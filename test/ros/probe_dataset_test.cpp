@@ -216,6 +216,31 @@ TEST_F(ProbeDataset, TwoShardsAreDisjointAndTogetherTheWholeDataset) {
   for (const auto& [key, n] : covered) EXPECT_EQ(n, 1);
 }
 
+TEST_F(ProbeDataset, SplitBagsAreEachValidAndTogetherHoldEveryFrame) {
+  // About 0.5 MB a frame: 40 frames split at 4 MB give several bags.
+  const fs::path dir = record("split", "seed:=3 split_mb:=4");
+  const std::vector<std::string> bags = bagsIn(dir);
+  EXPECT_GE(bags.size(), 4u);
+  for (const std::string& bag : bags) {
+    std::string info;
+    EXPECT_EQ(test::runCommand("rosbag info " + bag, info), 0) << info;
+  }
+  const std::string manifest = readFile(dir / "norm2tex_shard0.yaml");
+  for (const std::string& bag : bags) {
+    EXPECT_NE(manifest.find(fs::path(bag).filename().string()), std::string::npos) << manifest;
+  }
+  // Read as one recording: the same 40 frames, bit for bit, a frame cut by a split joined.
+  const std::map<ros::Time, Frame> frames = framesOf(dir);
+  ASSERT_EQ(frames.size(), frames3_->size());
+  for (const auto& [stamp, f] : *frames3_) {
+    const Frame& split = frames.at(stamp);
+    EXPECT_EQ(cv::norm(split.sample.image, f.sample.image, cv::NORM_INF), 0.0) << stamp;
+    EXPECT_EQ(cv::norm(split.sample.depth_m, f.sample.depth_m, cv::NORM_INF), 0.0) << stamp;
+    EXPECT_TRUE(split.sample.has_contact);
+    EXPECT_EQ(keyOf(split), keyOf(f));
+  }
+}
+
 TEST_F(ProbeDataset, ExportRoundTripsFramesLabelsAndBackgroundSubtraction) {
   ExportOptions options;
   options.out_dir = (scratch() / "export").string();
