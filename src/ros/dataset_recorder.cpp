@@ -19,6 +19,11 @@ namespace {
 using ros_params::badParameter;
 using ros_params::text;
 
+template <typename M>
+struct MessageTag {
+  using type = M;
+};
+
 bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
@@ -66,20 +71,35 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
   openNextBag();
 
   answer_pub_ = nh_.advertise<FrameRendered>(params_.answer_topic, 100, /*latch=*/true);
+  // Deep queues: in real time a slow disk must not drop frames unnoticed (drops are counted
+  // as received - written at the end).
   std::vector<std::string> topics = params_.topics;
-  for (const std::string& sensor : params_.sensors) {
-    for (const char* leaf : {"/image_raw", "/camera_info", "/depth", "/contact"}) {
-      topics.push_back(sensor + leaf);
-    }
-  }
   for (const std::string& topic : topics) {
     const std::string resolved = nh_.resolveName(topic);
-    // Deep queues: in real time a slow disk must not drop frames unnoticed (drops are counted
-    // as received - written at the end).
     subs_.push_back(nh_.subscribe<topic_tools::ShapeShifter>(
         topic, 1000, [this, resolved](const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
           onMessage(resolved, e);
         }));
+  }
+  // The per-frame topics typed: in a nodelet manager they arrive without a copy, and their
+  // stamps are read without deserialising them again.
+  auto subscribePart = [&](const std::string& topic, auto tag) {
+    using Message = typename decltype(tag)::type;
+    const std::string resolved = nh_.resolveName(topic);
+    topics.push_back(topic);
+    subs_.push_back(nh_.subscribe<Message>(
+        topic, 1000, [this, resolved](const ros::MessageEvent<Message const>& e) {
+          onFramePart(resolved, e.getConstMessage()->header.stamp,
+                      [&](const ros::Time& when) {
+                        bag_->write(resolved, when, e.getConstMessage(), e.getConnectionHeaderPtr());
+                      });
+        }));
+  };
+  for (const std::string& sensor : params_.sensors) {
+    subscribePart(sensor + "/image_raw", MessageTag<sensor_msgs::Image>());
+    subscribePart(sensor + "/camera_info", MessageTag<sensor_msgs::CameraInfo>());
+    subscribePart(sensor + "/depth", MessageTag<sensor_msgs::Image>());
+    subscribePart(sensor + "/contact", MessageTag<TactileContact>());
   }
   episode_sub_ = nh_.subscribe("episode", 10, &DatasetRecorder::onEpisode, this);
   frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &DatasetRecorder::onFrame, this);
@@ -155,36 +175,39 @@ std::string DatasetRecorder::labelAt(const ros::Time& stamp) const {
   return std::prev(it)->second;
 }
 
-void DatasetRecorder::onMessage(const std::string& topic,
-                                const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
+bool DatasetRecorder::write(const std::string& topic,
+                            const std::function<void(const ros::Time&)>& write_message) {
   ++received_[topic];
-  if (done_) return;
+  if (done_) return false;
   ros::Time when = ros::Time::now();
   if (when < ros::TIME_MIN) when = ros::TIME_MIN;  // bags cannot hold time 0
   try {
-    bag_->write(topic, when, e.getConstMessage(), e.getConnectionHeaderPtr());
+    write_message(when);
   } catch (const rosbag::BagException& ex) {
     error_ = std::string("writing ") + topic + " to " + bag_paths_.back() + " failed: " + ex.what();
     ROS_ERROR("dataset_recorder: %s; closing the bag", error_.c_str());
     stop_reason_ = "error";
     done_ = true;
-    return;
+    return false;
   }
   ++written_[topic];
-  // The frame this message belongs to, for the sensors' per-frame topics.
-  ros::Time stamp;
-  bool frame_part = true;
-  const topic_tools::ShapeShifter::ConstPtr& msg = e.getConstMessage();
-  if (endsWith(topic, "/image_raw") || endsWith(topic, "/depth")) {
-    stamp = msg->instantiate<sensor_msgs::Image>()->header.stamp;
-  } else if (endsWith(topic, "/camera_info")) {
-    stamp = msg->instantiate<sensor_msgs::CameraInfo>()->header.stamp;
-  } else if (endsWith(topic, "/contact")) {
-    stamp = msg->instantiate<TactileContact>()->header.stamp;
-  } else {
-    frame_part = false;
+  return true;
+}
+
+void DatasetRecorder::onMessage(const std::string& topic,
+                                const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
+  if (!write(topic, [&](const ros::Time& when) {
+        bag_->write(topic, when, e.getConstMessage(), e.getConnectionHeaderPtr());
+      })) {
+    return;
   }
-  if (frame_part && ++parts_at_[stamp] >= 4 * static_cast<int>(params_.sensors.size())) {
+  if (params_.split_mb > 0.0 && bag_->getSize() > params_.split_mb * 1e6) openNextBag();
+}
+
+void DatasetRecorder::onFramePart(const std::string& topic, const ros::Time& stamp,
+                                  const std::function<void(const ros::Time&)>& write_message) {
+  if (!write(topic, write_message)) return;
+  if (++parts_at_[stamp] >= 4 * static_cast<int>(params_.sensors.size())) {
     parts_at_.erase(stamp);
     completed_.insert(stamp);
     // Remembered for a while: the frame's SimFrame may arrive after its last part.
@@ -210,7 +233,7 @@ void DatasetRecorder::onMessage(const std::string& topic,
                    : "");
     }
   }
-  if (frame_part) answerFramesWritten();
+  answerFramesWritten();
   // At the target, finish the frames already begun (every topic of the last frame), then stop.
   if (target_reached_) {
     bool open_frames = false;

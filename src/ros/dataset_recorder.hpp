@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -58,7 +59,14 @@ class DatasetRecorder {
   const std::string& error() const { return error_; }
 
  private:
+  /// Counts a received message on `topic` and writes it with `write_message(bag time)`; false
+  /// (and done, with the error) when the write failed, or when recording is over.
+  bool write(const std::string& topic, const std::function<void(const ros::Time&)>& write_message);
+  /// Extra topics (TF, clock, joints, labels), as they come.
   void onMessage(const std::string& topic, const ros::MessageEvent<topic_tools::ShapeShifter>& e);
+  /// The sensors' per-frame topics: written, then counted towards their frame (`stamp`).
+  void onFramePart(const std::string& topic, const ros::Time& stamp,
+                   const std::function<void(const ros::Time&)>& write_message);
   void onFrame(const SimFrame::ConstPtr& frame);
   void onEpisode(const EpisodeInfo::ConstPtr& info);
   void openNextBag();
