@@ -18,8 +18,8 @@ constexpr const char* kUsage =
     "usage: norm2tex_bake NORMAL_MAP -o OUT.(tiff|tif|png) [--mask M] [--convention "
     "opengl|directx]\n"
     "                     [--range 0,-1|-1,1|0,1] [--alpha A] [--sigma-fine S] [--sigma-coarse S]\n"
-    "                     [--percentile-low P] [--percentile-high P] [--boundary mirror|periodic]\n"
-    "                     [--apron-refinements N] [--quiet]\n"
+    "                     [--percentile-low P] [--percentile-high P] [--boundary neumann|periodic]\n"
+    "                     [--tolerance T] [--max-iterations N] [--quiet]\n"
     "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels 0)\n"
     "  OUT.png:       8-bit preview, the range's low end black and high end white\n"
     "  Defaults are the paper's: convention opengl, range -1,1, alpha 0.2, sigma-fine 0.35,\n"
@@ -41,15 +41,17 @@ norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
   options.sigma_coarse = args.number("--sigma-coarse", options.sigma_coarse);
   options.percentile_low = args.number("--percentile-low", options.percentile_low);
   options.percentile_high = args.number("--percentile-high", options.percentile_high);
-  options.integration.apron_refinements =
-      args.integer("--apron-refinements", options.integration.apron_refinements);
-  const std::string boundary = args.value("--boundary", "mirror");
-  if (boundary == "mirror") {
-    options.integration.boundary = norm2tex::PoissonBoundary::kMirror;
+  options.integration.tolerance = args.number("--tolerance", options.integration.tolerance);
+  options.integration.max_iterations =
+      args.integer("--max-iterations", options.integration.max_iterations);
+  const std::string boundary = args.value("--boundary", "neumann");
+  // "mirror" is the old name of the cosine-transform (Neumann) solve.
+  if (boundary == "neumann" || boundary == "mirror") {
+    options.integration.boundary = norm2tex::PoissonBoundary::kNeumann;
   } else if (boundary == "periodic") {
     options.integration.boundary = norm2tex::PoissonBoundary::kPeriodic;
   } else {
-    throw norm2tex::Error("unknown --boundary '" + boundary + "'; valid: mirror, periodic");
+    throw norm2tex::Error("unknown --boundary '" + boundary + "'; valid: neumann, periodic");
   }
   norm2tex::validate(options);
   return options;
@@ -70,7 +72,7 @@ int run(int argc, char** argv) {
       argc, argv,
       {"-o", "--output", "--mask", "--convention", "--range", "--alpha", "--sigma-fine",
        "--sigma-coarse", "--percentile-low", "--percentile-high", "--boundary",
-       "--apron-refinements"},
+       "--tolerance", "--max-iterations"},
       {"--quiet", "-h", "--help"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;

@@ -12,8 +12,9 @@ namespace norm2tex {
 ///
 /// The key is a hash of everything the bake depends on: the bytes of the normal map and of the
 /// mask file, every BakeOptions field and the cache format version (not the path: moving a file
-/// keeps its entry). An entry is three files in the cache directory: `<key>.tiff` (H_global,
-/// 32-bit float), `<key>.valid.png` (mask) and `<key>.yaml` (metadata: source path and hash,
+/// keeps its entry). An entry is four files in the cache directory: `<key>.tiff` (H_global,
+/// 32-bit float), `<key>.valid.png` (mask), `<key>.islands.png` (the bake's island labels,
+/// 16-bit) and `<key>.yaml` (metadata: source path and hash,
 /// convention, parameters, island count), each written to a temporary name and renamed, the
 /// yaml last, so a crash mid-write leaves no entry that looks complete.
 class AtlasCache {

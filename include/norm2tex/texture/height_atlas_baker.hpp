@@ -37,12 +37,17 @@ struct BakeReport {
   int island_count = 0;
   int valid_texels = 0;
   cv::Vec2f percentile_values;  ///< blended height at percentile_low / percentile_high
+  int poisson_solves = 0;        ///< cosine/Fourier solves over all islands (1 per full box)
+  double worst_relative_residual = 0.0;  ///< of the islands' conjugate-gradient solves
+  int unconverged_islands = 0;   ///< islands whose solve hit max_iterations before tolerance
 };
 
 /// H_global from a decoded normal map: for every UV island on its own, a fine and a coarse
-/// pass (mask-aware Gaussian of the normals, gradients, Frankot-Chellappa), blended with
-/// alpha; then one percentile normalisation over all valid texels into `range`. Texels outside
-/// every island are 0 and invalid. Deterministic: same input and options, same bits.
+/// pass (mask-aware Gaussian of the normals, gradients), blended with alpha and integrated
+/// once (Frankot-Chellappa is linear: the same as integrating each pass and blending the
+/// heights); then one percentile normalisation over all valid texels into `range`. Texels
+/// outside every island are 0 and invalid; the atlas gets the bake's island labels.
+/// Deterministic: same input and options, same bits.
 HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& options = {},
                             const BakeProgress& progress = {}, BakeReport* report = nullptr);
 

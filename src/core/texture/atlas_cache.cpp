@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // Bump when the bake's output for the same input and options changes.
-constexpr int kFormatVersion = 1;
+constexpr int kFormatVersion = 2;  // 2: exact least squares on any island, island labels
 
 std::string describeOptions(const BakeOptions& o) {
   std::ostringstream text;
@@ -27,8 +27,9 @@ std::string describeOptions(const BakeOptions& o) {
        << ";sigma_fine=" << o.sigma_fine << ";sigma_coarse=" << o.sigma_coarse
        << ";alpha=" << o.alpha << ";percentile_low=" << o.percentile_low
        << ";percentile_high=" << o.percentile_high << ";range=" << toString(o.range) << ";boundary="
-       << (o.integration.boundary == PoissonBoundary::kMirror ? "mirror" : "periodic")
-       << ";apron_refinements=" << o.integration.apron_refinements
+       << (o.integration.boundary == PoissonBoundary::kNeumann ? "neumann" : "periodic")
+       << ";tolerance=" << o.integration.tolerance
+       << ";max_iterations=" << o.integration.max_iterations
        << ";remove_mean_slope=" << o.remove_mean_slope;
   return text.str();
 }
@@ -74,11 +75,16 @@ std::optional<HeightAtlas> AtlasCache::load(const std::string& key) const {
     const cv::Mat heights = cv::imread(entryPath(directory_, key, ".tiff"), cv::IMREAD_UNCHANGED);
     const cv::Mat valid =
         cv::imread(entryPath(directory_, key, ".valid.png"), cv::IMREAD_GRAYSCALE);
+    const cv::Mat labels =
+        cv::imread(entryPath(directory_, key, ".islands.png"), cv::IMREAD_UNCHANGED);
     if (heights.empty() || heights.type() != CV_32FC1 || valid.size() != heights.size() ||
+        labels.type() != CV_16UC1 || labels.size() != heights.size() ||
         heights.rows != metadata["rows"].as<int>() || heights.cols != metadata["cols"].as<int>()) {
       return std::nullopt;
     }
-    return HeightAtlas(heights, valid);
+    cv::Mat1i island_labels;
+    labels.convertTo(island_labels, CV_32S);
+    return HeightAtlas(heights, valid, island_labels);
   } catch (const std::exception&) {
     return std::nullopt;  // a damaged entry is a miss; the next store replaces it
   }
@@ -92,6 +98,15 @@ void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
   if (ec) throw Error("cannot create cache directory '" + directory_ + "': " + ec.message());
   writeImage(entryPath(directory_, key, ".tiff"), atlas.heights());
   writeImage(entryPath(directory_, key, ".valid.png"), atlas.valid());
+  // Island labels as 16-bit PNG: they are the bake's islands, not recomputable from the mask
+  // once islands come from a mesh's UV charts.
+  if (atlas.islandCount() > 65535) {
+    throw Error("cannot cache an atlas of " + std::to_string(atlas.islandCount()) +
+                " islands (at most 65535)");
+  }
+  cv::Mat labels;
+  atlas.islandLabels().convertTo(labels, CV_16U);
+  writeImage(entryPath(directory_, key, ".islands.png"), labels);
 
   YAML::Emitter yaml;
   yaml << YAML::BeginMap;

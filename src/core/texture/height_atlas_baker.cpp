@@ -1,24 +1,53 @@
 #include "norm2tex/texture/height_atlas_baker.hpp"
 
+#include <algorithm>
+
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
-#include "norm2tex/texture/masked_gaussian.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
+#include "texture/masked_gaussian.hpp"
+#include "texture/scratch_buffer.hpp"
 
 namespace norm2tex {
 namespace {
 
-/// One pass of the paper: smooth the normals, take slopes, integrate.
-cv::Mat1f integratePass(const cv::Mat3f& normals, const cv::Mat1b& mask, double sigma,
-                        const BakeOptions& options) {
-  const cv::Mat3f smoothed = maskedGaussianNormals(normals, mask, sigma);
-  cv::Mat1f dx, dy;
-  normalsToGradients(smoothed, mask, options.normal_map.min_nz, dx, dy);
+/// Buffers of the largest island so far, reused for every island of one bake.
+struct BakeWorkspace {
+  explicit BakeWorkspace(const IntegrationOptions& integration) : integrator(integration) {}
+  detail::ScratchBuffer<uchar> mask;
+  detail::ScratchBuffer<float> dx, dy, height;
+  detail::ScratchBuffer<cv::Vec3f> smoothed;
+  FrankotChellappaIntegrator integrator;
+};
+
+/// The blended height of one island: the fine and coarse passes' slopes blended with alpha,
+/// integrated once. Integration is linear, so this is (1 - alpha) H_fine + alpha H_coarse
+/// without a second solve.
+cv::Mat1f integrateIsland(const cv::Mat3f& normals, const cv::Mat1b& mask,
+                          const BakeOptions& options, BakeWorkspace& workspace,
+                          IntegrationReport& integration) {
+  cv::Mat1f dx = workspace.dx.view(mask.size()), dy = workspace.dy.view(mask.size());
+  dx.setTo(0.0f);
+  dy.setTo(0.0f);
+  const double min_nz = options.normal_map.min_nz;
+  // A pass with zero weight is skipped, not computed and multiplied by 0.
+  if (options.alpha < 1.0) {
+    detail::addMaskedGaussianSlopes(normals, mask, options.sigma_fine, min_nz,
+                                    static_cast<float>(1.0 - options.alpha), dx, dy,
+                                    workspace.smoothed);
+  }
+  if (options.alpha > 0.0) {
+    detail::addMaskedGaussianSlopes(normals, mask, options.sigma_coarse, min_nz,
+                                    static_cast<float>(options.alpha), dx, dy,
+                                    workspace.smoothed);
+  }
   if (options.remove_mean_slope) {
     cv::subtract(dx, cv::mean(dx, mask), dx, mask);
     cv::subtract(dy, cv::mean(dy, mask), dy, mask);
   }
-  return integrateFrankotChellappa(dx, dy, mask, options.integration);
+  cv::Mat1f height = workspace.height.view(mask.size());
+  workspace.integrator.integrate(dx, dy, mask, height, &integration);
+  return height;
 }
 
 }  // namespace
@@ -41,42 +70,40 @@ void validate(const BakeOptions& options) {
 HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& options,
                             const BakeProgress& progress, BakeReport* report) {
   validate(options);
-  const UvIslands islands = findUvIslands(normal_map.valid());
+  UvIslands islands = findUvIslands(normal_map.valid());
   if (islands.islands.empty()) {
     throw Error("the normal map has no valid texel (all masked by alpha, mask or nz <= " +
                 std::to_string(options.normal_map.min_nz) + ")");
   }
   const int valid_texels = normal_map.validCount();
-  cv::Mat1f blended(normal_map.rows(), normal_map.cols(), 0.0f);
+  cv::Mat1f global(normal_map.rows(), normal_map.cols(), 0.0f);
+  BakeWorkspace workspace(options.integration);
+  BakeReport summary;
   long done = 0;
   for (const UvIsland& island : islands.islands) {
     const cv::Rect box = island.bounding_box;
-    const cv::Mat1b mask = islands.labels(box) == island.label;
-    const cv::Mat3f normals = normal_map.normals()(box);
-    cv::Mat1f height;
-    // A pass with zero weight is skipped, not computed and multiplied by 0.
-    if (options.alpha < 1.0) {
-      height = integratePass(normals, mask, options.sigma_fine, options) * (1.0 - options.alpha);
-    }
-    if (options.alpha > 0.0) {
-      const cv::Mat1f coarse = integratePass(normals, mask, options.sigma_coarse, options);
-      height = height.empty() ? cv::Mat1f(coarse * options.alpha)
-                              : cv::Mat1f(height + coarse * options.alpha);
-    }
-    height.copyTo(blended(box), mask);
+    cv::Mat1b mask = workspace.mask.view(box.size());
+    cv::compare(islands.labels(box), island.label, mask, cv::CMP_EQ);
+    IntegrationReport integration;
+    const cv::Mat1f height =
+        integrateIsland(normal_map.normals()(box), mask, options, workspace, integration);
+    height.copyTo(global(box), mask);
+    summary.poisson_solves += integration.solves;
+    summary.worst_relative_residual =
+        std::max(summary.worst_relative_residual, integration.relative_residual);
+    if (!integration.converged) ++summary.unconverged_islands;
     done += island.texel_count;
     if (progress) progress(static_cast<double>(done) / valid_texels);
   }
 
-  const cv::Vec2f low_high = maskedPercentiles(blended, normal_map.valid(), options.percentile_low,
+  const cv::Vec2f low_high = maskedPercentiles(global, normal_map.valid(), options.percentile_low,
                                                options.percentile_high);
-  normalizeToRange(blended, normal_map.valid(), low_high, options.range);
-  if (report != nullptr) {
-    report->island_count = static_cast<int>(islands.islands.size());
-    report->valid_texels = valid_texels;
-    report->percentile_values = low_high;
-  }
-  return HeightAtlas(std::move(blended), normal_map.valid().clone());
+  normalizeToRange(global, normal_map.valid(), low_high, options.range);
+  summary.island_count = static_cast<int>(islands.islands.size());
+  summary.valid_texels = valid_texels;
+  summary.percentile_values = low_high;
+  if (report != nullptr) *report = summary;
+  return HeightAtlas(std::move(global), normal_map.valid().clone(), std::move(islands.labels));
 }
 
 }  // namespace norm2tex
