@@ -8,6 +8,7 @@
 
 #include "cli_arguments.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/common/image_io.hpp"
 #include "quiet_stderr.hpp"
@@ -68,6 +69,8 @@ cv::Mat previewImage(const norm2tex::HeightAtlas& atlas, norm2tex::HeightRange r
 }
 
 int run(int argc, char** argv) {
+  // Every large matrix of this short-lived process (the decoded PNG included) on huge pages.
+  cv::Mat::setDefaultAllocator(norm2tex::hugePageAllocator());
   const norm2tex::cli::Arguments args(
       argc, argv,
       {"-o", "--output", "--mask", "--convention", "--range", "--alpha", "--sigma-fine",

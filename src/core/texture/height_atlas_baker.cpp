@@ -4,6 +4,7 @@
 
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
 #include "texture/masked_gaussian.hpp"
 #include "texture/scratch_buffer.hpp"
@@ -76,7 +77,9 @@ HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& opti
                 std::to_string(options.normal_map.min_nz) + ")");
   }
   const int valid_texels = normal_map.validCount();
-  cv::Mat1f global(normal_map.rows(), normal_map.cols(), 0.0f);
+  cv::Mat1f global;
+  createWithHugePages(global, normal_map.rows(), normal_map.cols());
+  global.setTo(0.0f);
   BakeWorkspace workspace(options.integration);
   BakeReport summary;
   long done = 0;
