@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -21,7 +22,7 @@ constexpr const char* kUsage =
     "                     [--range 0,-1|-1,1|0,1] [--alpha A] [--sigma-fine S] [--sigma-coarse S]\n"
     "                     [--percentile-low P] [--percentile-high P] [--boundary neumann|periodic]\n"
     "                     [--tolerance T] [--max-iterations N] [--quiet]\n"
-    "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels 0)\n"
+    "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels NaN)\n"
     "  OUT.png:       8-bit preview, the range's low end black and high end white\n"
     "  Defaults are the paper's: convention opengl, range -1,1, alpha 0.2, sigma-fine 0.35,\n"
     "  sigma-coarse 1.1, percentiles 0.05 / 99.95.\n";
@@ -122,7 +123,11 @@ int run(int argc, char** argv) {
   if (extension == ".png") {
     norm2tex::writeImage(output, previewImage(atlas, options.range));
   } else {
-    norm2tex::writeImage(output, atlas.heights());
+    // Invalid texels are NaN in the TIFF: --atlas reads them back as invalid, so the file
+    // keeps the atlas's validity mask (0 would be a valid height of 0).
+    cv::Mat1f heights = atlas.heights().clone();
+    heights.setTo(std::numeric_limits<float>::quiet_NaN(), atlas.valid() == 0);
+    norm2tex::writeImage(output, heights);
   }
   if (!quiet) {
     std::printf("%s: %dx%d texels, %d valid, %d UV island%s\n", args.positional()[0].c_str(),

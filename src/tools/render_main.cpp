@@ -182,6 +182,11 @@ int run(int argc, char** argv) {
   if (args.has("--normal-map") && args.has("--atlas")) {
     throw norm2tex::cli::UsageError("give --normal-map or --atlas, not both");
   }
+  // Before any work or any file written: depth is float, the image 8-bit colour.
+  norm2tex::requireFormatHolds(output, CV_8UC3);
+  if (const auto depth_out = args.value("--depth-out")) {
+    norm2tex::requireFormatHolds(*depth_out, CV_32FC1);
+  }
 
   norm2tex::SensorModel model = args.has("--sensor")
                                     ? norm2tex::loadSensorModel(*args.value("--sensor"))

@@ -1,9 +1,9 @@
 #include <cmath>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
-#include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
@@ -112,7 +112,8 @@ TEST(FrankotChellappa, ConcaveIslandsMatchTheExactLeastSquaresSolve) {
     const double error = relativeRms(h, exact, island.mask);
     EXPECT_LT(error, 1e-3) << island.name;
     EXPECT_TRUE(report.converged) << island.name;
-    testing::Test::RecordProperty(std::string(island.name) + "_relative_rms", std::to_string(error));
+    testing::Test::RecordProperty(std::string(island.name) + "_relative_rms",
+                                  std::to_string(error));
     EXPECT_LE(report.solves, 40) << island.name;
     testing::Test::RecordProperty(std::string(island.name) + "_solves", report.solves);
   }
@@ -175,8 +176,8 @@ TEST(FrankotChellappa, PeriodicSolverIsExactOnATilingFieldOfAnySize) {
 TEST(FrankotChellappa, PeriodicSolutionSatisfiesThePeriodicPoissonEquation) {
   // Any patch size, including 1-texel strips: the discrete periodic Laplacian of the result
   // equals the periodic divergence of the edge targets wherever the equation is defined.
-  for (const cv::Size size : {cv::Size(1, 37), cv::Size(41, 1), cv::Size(7, 13),
-                              cv::Size(97, 101), cv::Size(2, 3), cv::Size(127, 64)}) {
+  for (const cv::Size size : {cv::Size(1, 37), cv::Size(41, 1), cv::Size(7, 13), cv::Size(97, 101),
+                              cv::Size(2, 3), cv::Size(127, 64)}) {
     const AnalyticSurface s = makeWaves(size, {{1.0, 9.0, 0.6, 0.0}});
     const cv::Mat1b all(size, 255);
     const cv::Mat1f h = integrateFrankotChellappa(s.dx, s.dy, all, periodic());
@@ -188,8 +189,10 @@ TEST(FrankotChellappa, PeriodicSolutionSatisfiesThePeriodicPoissonEquation) {
         const int cp = (c + 1) % cols, cm = (c + cols - 1) % cols;
         const int rp = (r + 1) % rows, rm = (r + rows - 1) % rows;
         const double laplace = h(r, cp) + h(r, cm) + h(rp, c) + h(rm, c) - 4.0 * h(r, c);
-        const double gx = 0.5 * (s.dx(r, c) + s.dx(r, cp)), gx_left = 0.5 * (s.dx(r, cm) + s.dx(r, c));
-        const double gy = 0.5 * (s.dy(r, c) + s.dy(rp, c)), gy_up = 0.5 * (s.dy(rm, c) + s.dy(r, c));
+        const double gx = 0.5 * (s.dx(r, c) + s.dx(r, cp)),
+                     gx_left = 0.5 * (s.dx(r, cm) + s.dx(r, c));
+        const double gy = 0.5 * (s.dy(r, c) + s.dy(rp, c)),
+                     gy_up = 0.5 * (s.dy(rm, c) + s.dy(r, c));
         const double div = gx - gx_left + gy - gy_up;
         scale = std::max(scale, std::fabs(div));
         worst = std::max(worst, std::fabs(laplace - div));

@@ -44,8 +44,12 @@ TEST_F(BakeCli, WritesAFloatTiffOfTheMapsSize) {
   const cv::Mat h = cv::imread(path("h.tiff"), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(h.type(), CV_32FC1);
   EXPECT_EQ(h.size(), cv::Size(96, 64));
+  // Texels outside the islands are NaN (invalid), the islands finite and in [-1, 1].
+  const cv::Mat1b mask = cv::imread(path("mask.png"), cv::IMREAD_GRAYSCALE);
+  const cv::Mat1b finite = h == h;  // NaN != NaN
+  EXPECT_EQ(cv::countNonZero(finite != (mask != 0)), 0);
   double low, high;
-  cv::minMaxLoc(h, &low, &high);
+  cv::minMaxLoc(h, &low, &high, nullptr, nullptr, mask);
   EXPECT_FLOAT_EQ(low, -1.0f);
   EXPECT_FLOAT_EQ(high, 1.0f);
 }
@@ -68,8 +72,16 @@ TEST_F(BakeCli, BadInputExitsNonZeroWithOneLineReason) {
   std::ofstream(path("corrupt.png")) << "\x89PNG\r\n\x1a\ngarbage";
   cv::imwrite(path("gray.png"), cv::Mat(8, 8, CV_8UC1, cv::Scalar(9)));
   cv::imwrite(path("transparent.png"), cv::Mat(8, 8, CV_8UC4, cv::Scalar(255, 128, 128, 0)));
-  for (const std::string input :
-       {"missing.png", "empty.png", "corrupt.png", "gray.png", "transparent.png"}) {
+  // The first 1000 bytes of a real JPEG: libjpeg alone would decode it with grey rows.
+  cv::Mat noise(64, 96, CV_8UC3);
+  cv::randu(noise, 0, 255);
+  cv::imwrite(path("whole.jpg"), noise);
+  std::ifstream whole(path("whole.jpg"), std::ios::binary);
+  std::string bytes(1000, '\0');
+  whole.read(&bytes[0], 1000);
+  std::ofstream(path("truncated.jpg"), std::ios::binary) << bytes;
+  for (const std::string input : {"missing.png", "empty.png", "corrupt.png", "gray.png",
+                                  "transparent.png", "truncated.jpg"}) {
     const CliRun run = bake(path(input) + " -o " + path("out.tiff"));
     EXPECT_EQ(run.exit_code, 1) << input << ": " << run.output;
     EXPECT_EQ(run.output.rfind("norm2tex_bake: error: ", 0), 0u) << run.output;

@@ -18,7 +18,9 @@ struct TextureSource {
   std::uint64_t seed = 0;       ///< material seed
   std::string normal_map;       ///< PNG/JPEG/TIFF normal map, baked through the AtlasCache
   NormalConvention convention = NormalConvention::kOpenGL;
-  std::string atlas;  ///< a baked H_global: single-channel 32-bit float TIFF
+  /// A baked H_global: single-channel 32-bit float TIFF; NaN texels are invalid (what
+  /// norm2tex_bake writes outside every island), infinite ones an error.
+  std::string atlas;
 };
 
 /// H_global for the TextureOverlay, and what it came from.

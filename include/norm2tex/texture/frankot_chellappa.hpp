@@ -34,9 +34,9 @@ void validate(const IntegrationOptions& options);
 
 /// How one integration went (kNeumann; kPeriodic reports 1 solve, residual 0).
 struct IntegrationReport {
-  int solves = 0;               ///< cosine/Fourier Poisson solves done
+  int solves = 0;                ///< cosine/Fourier Poisson solves done
   double relative_residual = 0;  ///< final sqrt(r.Mr / b.Mb)
-  bool converged = true;        ///< false when max_iterations ran out first
+  bool converged = true;         ///< false when max_iterations ran out first
 };
 
 /// Least-squares integration of a gradient field over one island (Frankot-Chellappa).
@@ -60,8 +60,8 @@ class FrankotChellappaIntegrator {
 
   /// Writes the height into `height` (reallocated unless it already has dx's size and type).
   /// Throws Error on empty or mismatched input.
-  void integrate(const cv::Mat1f& dx, const cv::Mat1f& dy, const cv::Mat1b& mask,
-                 cv::Mat1f& height, IntegrationReport* report = nullptr);
+  void integrate(const cv::Mat1f& dx, const cv::Mat1f& dy, const cv::Mat1b& mask, cv::Mat1f& height,
+                 IntegrationReport* report = nullptr);
 
  private:
   struct Workspace;

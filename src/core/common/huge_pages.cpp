@@ -11,7 +11,9 @@ namespace {
 constexpr size_t kHugePage = size_t(2) << 20;
 
 /// Length of the mapping behind a matrix of `bytes`: whole huge pages plus one for alignment.
-size_t mappingLength(size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage + kHugePage; }
+size_t mappingLength(size_t bytes) {
+  return (bytes + kHugePage - 1) / kHugePage * kHugePage + kHugePage;
+}
 
 class HugePageAllocator final : public cv::MatAllocator {
  public:
@@ -48,8 +50,7 @@ class HugePageAllocator final : public cv::MatAllocator {
       throw std::bad_alloc();
     }
     const auto address = reinterpret_cast<std::uintptr_t>(base);
-    uchar* aligned =
-        reinterpret_cast<uchar*>((address + kHugePage - 1) / kHugePage * kHugePage);
+    uchar* aligned = reinterpret_cast<uchar*>((address + kHugePage - 1) / kHugePage * kHugePage);
     madvise(aligned, length - static_cast<size_t>(aligned - static_cast<uchar*>(base)),
             MADV_HUGEPAGE);  // advice only: without huge pages this is an ordinary mapping
     u->origdata = static_cast<uchar*>(base);

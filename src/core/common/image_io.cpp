@@ -4,10 +4,12 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <system_error>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/image_file_check.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -30,9 +32,18 @@ cv::Mat readImage(const std::string& path, int flags, const std::string& what) {
     throw Error(what + " '" + path + "' cannot be opened (permissions?)");
   }
   if (fs::file_size(path, ec) == 0) throw Error(what + " '" + path + "' is an empty file");
+  std::vector<unsigned char> bytes;
+  {
+    std::ifstream file(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+    if (!file.good() && !file.eof()) throw Error(what + " '" + path + "' cannot be read");
+  }
+  if (const std::string reason = detail::incompleteImageReason(bytes); !reason.empty()) {
+    throw Error(what + " '" + path + "' is corrupt: " + reason);
+  }
   cv::Mat image;
   try {
-    image = cv::imread(path, flags);
+    image = cv::imdecode(bytes, flags);
   } catch (const cv::Exception& e) {
     throw Error(what + " '" + path + "' cannot be decoded: " + e.what());
   }
@@ -43,8 +54,30 @@ cv::Mat readImage(const std::string& path, int flags, const std::string& what) {
   return image;
 }
 
+void requireFormatHolds(const std::string& path, int type) {
+  const std::string extension = lowerCaseExtension(path);
+  const int depth = CV_MAT_DEPTH(type);
+  const bool float_data = depth == CV_32F || depth == CV_64F;
+  const bool float_format = extension == ".tiff" || extension == ".tif" || extension == ".exr" ||
+                            extension == ".pfm" || extension == ".hdr";
+  const bool sixteen_bit_format = float_format || extension == ".png" || extension == ".pgm" ||
+                                  extension == ".ppm" || extension == ".pnm";
+  // OpenCV would convert silently: float depth in metres to PNG saturates to 0 or 1.
+  if (float_data && !float_format) {
+    throw Error("cannot write floating-point data to '" + path + "': " +
+                (extension.empty() ? std::string("no extension") : extension) +
+                " holds only integers; use .tiff");
+  }
+  if (depth == CV_16U && !sixteen_bit_format) {
+    throw Error("cannot write 16-bit data to '" + path + "': " +
+                (extension.empty() ? std::string("no extension") : extension) +
+                " holds only 8 bits; use .png or .tiff");
+  }
+}
+
 void writeImage(const std::string& path, const cv::Mat& image) {
   if (image.empty()) throw Error("refusing to write an empty image to '" + path + "'");
+  requireFormatHolds(path, image.type());
   const fs::path target(path);
   std::error_code ec;
   if (target.has_parent_path() && !fs::is_directory(target.parent_path(), ec)) {

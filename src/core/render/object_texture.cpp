@@ -1,5 +1,7 @@
 #include "norm2tex/render/object_texture.hpp"
 
+#include <cmath>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "norm2tex/common/error.hpp"
@@ -44,7 +46,25 @@ ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& m
       throw Error("atlas '" + source.atlas +
                   "' must be a single-channel 32-bit float TIFF (norm2tex_bake -o X.tiff)");
     }
-    out.atlas = std::make_shared<HeightAtlas>(heights, cv::Mat1b(heights.size(), 255));
+    // NaN marks an invalid texel (norm2tex_bake writes its mask so); an infinite height is
+    // broken data, which would otherwise press the gel without bound.
+    cv::Mat1b valid(heights.size(), 255);
+    int infinite = 0;
+    for (int r = 0; r < heights.rows; ++r) {
+      const float* h = heights.ptr<float>(r);
+      for (int c = 0; c < heights.cols; ++c) {
+        if (std::isinf(h[c])) ++infinite;
+        if (!std::isfinite(h[c])) valid(r, c) = 0;
+      }
+    }
+    if (infinite > 0) {
+      throw Error("atlas '" + source.atlas + "' has " + std::to_string(infinite) +
+                  " infinite texels; heights must be finite (NaN marks an invalid texel)");
+    }
+    if (cv::countNonZero(valid) == 0) {
+      throw Error("atlas '" + source.atlas + "' has no valid texel (every texel is NaN)");
+    }
+    out.atlas = std::make_shared<HeightAtlas>(heights, valid);
     out.description = "atlas " + source.atlas;
     return out;
   }

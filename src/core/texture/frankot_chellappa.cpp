@@ -95,8 +95,7 @@ void FrankotChellappaIntegrator::integrate(const cv::Mat1f& dx, const cv::Mat1f&
 }
 
 cv::Mat1f integrateFrankotChellappa(const cv::Mat1f& dx, const cv::Mat1f& dy, const cv::Mat1b& mask,
-                                    const IntegrationOptions& options,
-                                    IntegrationReport* report) {
+                                    const IntegrationOptions& options, IntegrationReport* report) {
   cv::Mat1f height;
   FrankotChellappaIntegrator(options).integrate(dx, dy, mask, height, report);
   return height;

@@ -39,8 +39,7 @@ cv::Mat1f integrateIsland(const cv::Mat3f& normals, const cv::Mat1b& mask,
   }
   if (options.alpha > 0.0) {
     detail::addMaskedGaussianSlopes(normals, mask, options.sigma_coarse, min_nz,
-                                    static_cast<float>(options.alpha), dx, dy,
-                                    workspace.smoothed);
+                                    static_cast<float>(options.alpha), dx, dy, workspace.smoothed);
   }
   if (options.remove_mean_slope) {
     cv::subtract(dx, cv::mean(dx, mask), dx, mask);

@@ -118,7 +118,8 @@ cv::Vec2f maskedPercentiles(const cv::Mat1f& height, const cv::Mat1b& mask, doub
   detail::requireParameter(
       0.0 <= low_percent && low_percent < high_percent && high_percent <= 100.0, "percentiles",
       std::to_string(low_percent) + "," + std::to_string(high_percent), "0 <= low < high <= 100");
-  if (height.size() != mask.size()) throw Error("maskedPercentiles: height and mask differ in size");
+  if (height.size() != mask.size())
+    throw Error("maskedPercentiles: height and mask differ in size");
   OrderStatistics values(height, mask);
   if (values.count() == 0) throw Error("percentiles of an empty set: no valid texel");
   // Linear interpolation between the order statistics around rank p (n - 1) / 100.

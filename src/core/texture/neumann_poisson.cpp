@@ -23,13 +23,12 @@ int NeumannPoissonSolver::transformLength(int n) {
 void NeumannPoissonSolver::prepare(int rows, int cols) {
   if (rows == rows_ && cols == cols_) return;
   if (rows % 2 != 0 || cols % 2 != 0) {
-    throw Error("NeumannPoissonSolver: transform sizes must be even, got " +
-                std::to_string(cols) + "x" + std::to_string(rows));
+    throw Error("NeumannPoissonSolver: transform sizes must be even, got " + std::to_string(cols) +
+                "x" + std::to_string(rows));
   }
   const auto eigenvalues = [](int n) {
     std::vector<float> lambda(n);
-    for (int k = 0; k < n; ++k)
-      lambda[k] = static_cast<float>(2.0 * std::cos(CV_PI * k / n) - 2.0);
+    for (int k = 0; k < n; ++k) lambda[k] = static_cast<float>(2.0 * std::cos(CV_PI * k / n) - 2.0);
     return lambda;
   };
   const auto twiddles = [](int n, std::vector<float>& cosines, std::vector<float>& sines) {
