@@ -1,4 +1,5 @@
 // norm2tex_bake: normal map -> H_global (32-bit float TIFF) or an 8-bit PNG preview.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -10,8 +11,9 @@
 #include "cli_arguments.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/huge_pages.hpp"
-#include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/common/image_io.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/relief_spectrum.hpp"
 #include "quiet_stderr.hpp"
 
 namespace {
@@ -20,12 +22,20 @@ constexpr const char* kUsage =
     "usage: norm2tex_bake NORMAL_MAP -o OUT.(tiff|tif|png) [--mask M] [--convention "
     "opengl|directx]\n"
     "                     [--range 0,-1|-1,1|0,1] [--alpha A] [--sigma-fine S] [--sigma-coarse S]\n"
-    "                     [--percentile-low P] [--percentile-high P] [--boundary neumann|periodic]\n"
-    "                     [--tolerance T] [--max-iterations N] [--quiet]\n"
+    "                     [--percentile-low P] [--percentile-high P] [--boundary "
+    "neumann|periodic]\n"
+    "                     [--tolerance T] [--max-iterations N]\n"
+    "                     [--relief-cutoff-texels N | --relief-cutoff-mm MM] [--mm-per-texel MM]\n"
+    "                     [--physical] [--paper-exact] [--quiet]\n"
     "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels NaN)\n"
     "  OUT.png:       8-bit preview, the range's low end black and high end white\n"
     "  Defaults are the paper's: convention opengl, range -1,1, alpha 0.2, sigma-fine 0.35,\n"
-    "  sigma-coarse 1.1, percentiles 0.05 / 99.95.\n";
+    "  sigma-coarse 1.1, percentiles 0.05 / 99.95; plus mean-slope removal and a relief\n"
+    "  high-pass: wavelengths above 64 texels (2 mm with --mm-per-texel) are drift, not relief\n"
+    "  (0 = keep all).\n"
+    "  --mm-per-texel: millimetres of surface per texel; with --physical H_global is in mm\n"
+    "                  (the relief the normal map implies) and beta becomes a gain.\n"
+    "  --paper-exact:  the paper's bake only (no high-pass, no mean-slope removal, periodic).\n";
 
 using Clock = std::chrono::steady_clock;
 
@@ -34,7 +44,8 @@ double secondsSince(Clock::time_point start) {
 }
 
 norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
-  norm2tex::BakeOptions options;
+  norm2tex::BakeOptions options =
+      args.flag("--paper-exact") ? norm2tex::paperExactBakeOptions() : norm2tex::BakeOptions();
   options.normal_map.convention =
       norm2tex::parseNormalConvention(args.value("--convention", "opengl"));
   options.range = norm2tex::parseHeightRange(args.value("--range", "-1,1"));
@@ -46,7 +57,17 @@ norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
   options.integration.tolerance = args.number("--tolerance", options.integration.tolerance);
   options.integration.max_iterations =
       args.integer("--max-iterations", options.integration.max_iterations);
-  const std::string boundary = args.value("--boundary", "neumann");
+  options.relief_cutoff_texels =
+      args.number("--relief-cutoff-texels", options.relief_cutoff_texels);
+  options.relief_cutoff_mm = args.number("--relief-cutoff-mm", options.relief_cutoff_mm);
+  options.mm_per_texel = args.number("--mm-per-texel", options.mm_per_texel);
+  options.physical_scale = args.flag("--physical");
+  if (args.has("--relief-cutoff-mm") && !args.has("--mm-per-texel")) {
+    throw norm2tex::cli::UsageError("--relief-cutoff-mm needs --mm-per-texel");
+  }
+  const std::string default_boundary =
+      options.integration.boundary == norm2tex::PoissonBoundary::kPeriodic ? "periodic" : "neumann";
+  const std::string boundary = args.value("--boundary", default_boundary);
   // "mirror" is the old name of the cosine-transform (Neumann) solve.
   if (boundary == "neumann" || boundary == "mirror") {
     options.integration.boundary = norm2tex::PoissonBoundary::kNeumann;
@@ -59,9 +80,15 @@ norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
   return options;
 }
 
-/// The range's low end maps to 0, its high end to 255; invalid texels are 0.
-cv::Mat previewImage(const norm2tex::HeightAtlas& atlas, norm2tex::HeightRange range) {
-  const cv::Vec2f bounds = norm2tex::rangeBounds(range);
+/// The range's low end maps to 0, its high end to 255 (with --physical: the lowest and highest
+/// valid height); invalid texels are 0.
+cv::Mat previewImage(const norm2tex::HeightAtlas& atlas, const norm2tex::BakeOptions& options) {
+  cv::Vec2f bounds = norm2tex::rangeBounds(options.range);
+  if (options.physical_scale) {
+    double low = 0.0, high = 0.0;
+    cv::minMaxLoc(atlas.heights(), &low, &high, nullptr, nullptr, atlas.valid());
+    bounds = cv::Vec2f(static_cast<float>(low), static_cast<float>(std::max(high, low + 1e-9)));
+  }
   cv::Mat preview;
   atlas.heights().convertTo(preview, CV_8U, 255.0 / (bounds[1] - bounds[0]),
                             -255.0 * bounds[0] / (bounds[1] - bounds[0]));
@@ -75,9 +102,9 @@ int run(int argc, char** argv) {
   const norm2tex::cli::Arguments args(
       argc, argv,
       {"-o", "--output", "--mask", "--convention", "--range", "--alpha", "--sigma-fine",
-       "--sigma-coarse", "--percentile-low", "--percentile-high", "--boundary",
-       "--tolerance", "--max-iterations"},
-      {"--quiet", "-h", "--help"});
+       "--sigma-coarse", "--percentile-low", "--percentile-high", "--boundary", "--tolerance",
+       "--max-iterations", "--relief-cutoff-texels", "--relief-cutoff-mm", "--mm-per-texel"},
+      {"--quiet", "-h", "--help", "--physical", "--paper-exact"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
     return 0;
@@ -121,7 +148,7 @@ int run(int argc, char** argv) {
   const double bake_seconds = secondsSince(bake_start);
 
   if (extension == ".png") {
-    norm2tex::writeImage(output, previewImage(atlas, options.range));
+    norm2tex::writeImage(output, previewImage(atlas, options));
   } else {
     // Invalid texels are NaN in the TIFF: --atlas reads them back as invalid, so the file
     // keeps the atlas's validity mask (0 would be a valid height of 0).
@@ -133,6 +160,27 @@ int run(int argc, char** argv) {
     std::printf("%s: %dx%d texels, %d valid, %d UV island%s\n", args.positional()[0].c_str(),
                 normal_map.cols(), normal_map.rows(), report.valid_texels, report.island_count,
                 report.island_count == 1 ? "" : "s");
+    if (report.relief_cutoff_texels > 0.0) {
+      std::printf("relief high-pass at %.4g texels; ", report.relief_cutoff_texels);
+    } else {
+      std::printf("no relief high-pass; ");
+    }
+    std::printf(
+        "%.0f %% of H_global's variance at wavelengths above 64 texels\n",
+        100.0 * norm2tex::longWavelengthVarianceFraction(atlas.heights(), atlas.valid(), 64.0));
+    if (options.mm_per_texel > 0.0) {
+      std::printf("implied relief amplitude %.4g mm (percentiles %.2f..%.2f at %.4g mm/texel)%s\n",
+                  report.relief_amplitude_mm, options.percentile_low, options.percentile_high,
+                  options.mm_per_texel,
+                  options.physical_scale ? "; H_global in mm, use beta as a gain (1)" : "");
+    }
+    if (report.unconverged_islands > 0) {
+      std::fprintf(stderr,
+                   "norm2tex_bake: warning: %d island(s) stopped at --max-iterations %d with "
+                   "relative residual %.2g (tolerance %.2g)\n",
+                   report.unconverged_islands, options.integration.max_iterations,
+                   report.worst_relative_residual, options.integration.tolerance);
+    }
     std::printf("range %s, percentiles %.2f/%.2f at %.6g/%.6g\n",
                 norm2tex::toString(options.range).c_str(), options.percentile_low,
                 options.percentile_high, report.percentile_values[0], report.percentile_values[1]);

@@ -79,12 +79,12 @@ TEST(ContactRasterizer, FinelyTessellatedPlaneCoversEveryPixelExactlyOnce) {
   const SensorModel model = makeDigitSensorModel();
   // Quads of about 4 pixels, and sub-pixel triangles; jittered (by at most 0.2 of a quad, so
   // no triangle folds over) and turned: edges at all angles. 40 mm covers the turned gel.
-  expectEveryPixelExactlyOnce(makeGrid(120, 40.0, 0.2, model), pressedAndTurned(0.5, 0.0),
-                              model, "120x120 quads");
-  expectEveryPixelExactlyOnce(makeGrid(120, 40.0, 0.2, model), pressedAndTurned(0.5, 0.37),
-                              model, "120x120 quads, turned");
-  expectEveryPixelExactlyOnce(makeGrid(700, 40.0, 0.2, model), pressedAndTurned(0.5, 0.11),
-                              model, "700x700 sub-pixel quads");
+  expectEveryPixelExactlyOnce(makeGrid(120, 40.0, 0.2, model), pressedAndTurned(0.5, 0.0), model,
+                              "120x120 quads");
+  expectEveryPixelExactlyOnce(makeGrid(120, 40.0, 0.2, model), pressedAndTurned(0.5, 0.37), model,
+                              "120x120 quads, turned");
+  expectEveryPixelExactlyOnce(makeGrid(700, 40.0, 0.2, model), pressedAndTurned(0.5, 0.11), model,
+                              "700x700 sub-pixel quads");
 }
 
 TEST(ContactRasterizer, CentresExactlyOnEdgesAndCornersAreDrawnOnce) {

@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // Bump when the bake's output for the same input and options changes.
-constexpr int kFormatVersion = 2;  // 2: exact least squares on any island, island labels
+constexpr int kFormatVersion = 2;  // 2: exact least squares, island labels, relief cutoff
 
 std::string describeOptions(const BakeOptions& o) {
   std::ostringstream text;
@@ -30,7 +30,9 @@ std::string describeOptions(const BakeOptions& o) {
        << (o.integration.boundary == PoissonBoundary::kNeumann ? "neumann" : "periodic")
        << ";tolerance=" << o.integration.tolerance
        << ";max_iterations=" << o.integration.max_iterations
-       << ";remove_mean_slope=" << o.remove_mean_slope;
+       << ";remove_mean_slope=" << o.remove_mean_slope << ";relief_cutoff_mm=" << o.relief_cutoff_mm
+       << ";relief_cutoff_texels=" << o.relief_cutoff_texels << ";mm_per_texel=" << o.mm_per_texel
+       << ";physical_scale=" << o.physical_scale;
   return text.str();
 }
 

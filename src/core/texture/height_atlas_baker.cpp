@@ -7,6 +7,7 @@
 #include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
 #include "texture/masked_gaussian.hpp"
+#include "texture/relief_filter.hpp"
 #include "texture/scratch_buffer.hpp"
 
 namespace norm2tex {
@@ -19,6 +20,7 @@ struct BakeWorkspace {
   detail::ScratchBuffer<float> dx, dy, height;
   detail::ScratchBuffer<cv::Vec3f> smoothed;
   FrankotChellappaIntegrator integrator;
+  detail::ReliefFilter relief;
 };
 
 /// The blended height of one island: the fine and coarse passes' slopes blended with alpha,
@@ -45,12 +47,42 @@ cv::Mat1f integrateIsland(const cv::Mat3f& normals, const cv::Mat1b& mask,
     cv::subtract(dx, cv::mean(dx, mask), dx, mask);
     cv::subtract(dy, cv::mean(dy, mask), dy, mask);
   }
+  workspace.relief.removeLongWavelengths(dx, dy, mask, reliefCutoffTexels(options));
   cv::Mat1f height = workspace.height.view(mask.size());
   workspace.integrator.integrate(dx, dy, mask, height, &integration);
   return height;
 }
 
+/// Heights in texel units times mm per texel: millimetres. The range picks the zero: the high
+/// percentile for 0,-1 (peaks at 0), the low one for 0,1, the mean for -1,1 (already 0).
+void toPhysicalScale(cv::Mat1f& height, const cv::Mat1b& valid, cv::Vec2f low_high,
+                     const BakeOptions& options) {
+  float zero = 0.0f;
+  if (options.range == HeightRange::kRemove) zero = low_high[1];
+  if (options.range == HeightRange::kAdd) zero = low_high[0];
+  const float scale = static_cast<float>(options.mm_per_texel);
+  for (int r = 0; r < height.rows; ++r) {
+    float* h = height.ptr<float>(r);
+    const uchar* ok = valid.ptr<uchar>(r);
+    for (int c = 0; c < height.cols; ++c) h[c] = ok[c] ? (h[c] - zero) * scale : 0.0f;
+  }
+}
+
 }  // namespace
+
+BakeOptions paperExactBakeOptions() {
+  BakeOptions options;
+  options.relief_cutoff_mm = 0.0;
+  options.relief_cutoff_texels = 0.0;
+  options.remove_mean_slope = false;
+  options.integration.boundary = PoissonBoundary::kPeriodic;
+  return options;
+}
+
+double reliefCutoffTexels(const BakeOptions& options) {
+  if (options.mm_per_texel > 0.0) return options.relief_cutoff_mm / options.mm_per_texel;
+  return options.relief_cutoff_texels;
+}
 
 void validate(const BakeOptions& options) {
   validate(options.normal_map);
@@ -65,6 +97,18 @@ void validate(const BakeOptions& options) {
                            "percentile_low", options.percentile_low, "[0, 50) percent");
   detail::requireParameter(options.percentile_high > 50.0 && options.percentile_high <= 100.0,
                            "percentile_high", options.percentile_high, "(50, 100] percent");
+  detail::requireParameter(options.relief_cutoff_mm >= 0.0 && options.relief_cutoff_mm <= 1000.0,
+                           "relief_cutoff_mm", options.relief_cutoff_mm, "[0, 1000] mm (0 = off)");
+  detail::requireParameter(
+      options.relief_cutoff_texels >= 0.0 && options.relief_cutoff_texels <= 1e6,
+      "relief_cutoff_texels", options.relief_cutoff_texels, "[0, 1e6] texels (0 = off)");
+  detail::requireParameter(options.mm_per_texel >= 0.0 && options.mm_per_texel <= 100.0,
+                           "mm_per_texel", options.mm_per_texel, "[0, 100] mm (0 = unknown)");
+  if (options.physical_scale && !(options.mm_per_texel > 0.0)) {
+    throw Error(
+        "physical_scale needs mm_per_texel (the surface's millimetres per texel, from a mesh's "
+        "UVs or the texture's size)");
+  }
 }
 
 HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& options,
@@ -100,10 +144,16 @@ HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& opti
 
   const cv::Vec2f low_high = maskedPercentiles(global, normal_map.valid(), options.percentile_low,
                                                options.percentile_high);
-  normalizeToRange(global, normal_map.valid(), low_high, options.range);
+  if (options.physical_scale) {
+    toPhysicalScale(global, normal_map.valid(), low_high, options);
+  } else {
+    normalizeToRange(global, normal_map.valid(), low_high, options.range);
+  }
   summary.island_count = static_cast<int>(islands.islands.size());
   summary.valid_texels = valid_texels;
   summary.percentile_values = low_high;
+  summary.relief_cutoff_texels = reliefCutoffTexels(options);
+  summary.relief_amplitude_mm = (low_high[1] - low_high[0]) * options.mm_per_texel;
   if (report != nullptr) *report = summary;
   return HeightAtlas(std::move(global), normal_map.valid().clone(), std::move(islands.labels));
 }

@@ -7,7 +7,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "texture/scratch_buffer.hpp"
+#include "texture/cosine_transform.hpp"
 
 namespace norm2tex {
 namespace detail {
@@ -22,23 +22,13 @@ class NeumannPoissonSolver {
   void solve(const cv::Mat1f& b, cv::Mat1f& z);
 
   /// The smallest even length >= n whose real DFT is fast.
-  static int transformLength(int n);
+  static int transformLength(int n) { return CosineTransform::transformLength(n); }
 
  private:
-  /// Cosine (DCT-II, unnormalised) of every row of `in` into `out` (out != in).
-  void forwardRows(const cv::Mat1f& in, cv::Mat1f& out, const std::vector<float>& cosines,
-                   const std::vector<float>& sines);
-  /// Inverse of forwardRows; overwrites `in`.
-  void inverseRows(cv::Mat1f& in, cv::Mat1f& out, const std::vector<float>& cosines,
-                   const std::vector<float>& sines);
   void prepare(int rows, int cols);
-
   int rows_ = 0, cols_ = 0;
   std::vector<float> lambda_x_, lambda_y_;  // eigenvalues of the 1-D second difference, <= 0
-  // Twiddles cos(pi k / 2n), sin(pi k / 2n) for k <= n / 2, per axis.
-  std::vector<float> cos_x_, sin_x_, cos_y_, sin_y_;
-  std::vector<float> row_;
-  ScratchBuffer<float> first_, second_;
+  CosineTransform transform_;
 };
 
 }  // namespace detail

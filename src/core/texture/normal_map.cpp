@@ -41,7 +41,6 @@ std::string describeChannels(int channels) {
   return std::to_string(channels) + " channels";
 }
 
-
 /// n = normalize(2c - 1) per texel, straight from the image's own pixel type (no float copy of
 /// the image: a 2048^2 RGBA map would be 64 MB of temporaries). Alpha, when present and no
 /// explicit mask was given, is the validity mask.
