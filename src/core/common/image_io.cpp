@@ -4,7 +4,6 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <system_error>
 
 #include <opencv2/imgcodecs.hpp>
@@ -32,11 +31,12 @@ cv::Mat readImage(const std::string& path, int flags, const std::string& what) {
     throw Error(what + " '" + path + "' cannot be opened (permissions?)");
   }
   if (fs::file_size(path, ec) == 0) throw Error(what + " '" + path + "' is an empty file");
-  std::vector<unsigned char> bytes;
+  // One read of the whole file: checked for completeness, then decoded from memory.
+  std::vector<unsigned char> bytes(static_cast<size_t>(fs::file_size(path, ec)));
   {
     std::ifstream file(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-    if (!file.good() && !file.eof()) throw Error(what + " '" + path + "' cannot be read");
+    file.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!file || ec) throw Error(what + " '" + path + "' cannot be read");
   }
   if (const std::string reason = detail::incompleteImageReason(bytes); !reason.empty()) {
     throw Error(what + " '" + path + "' is corrupt: " + reason);
@@ -64,13 +64,13 @@ void requireFormatHolds(const std::string& path, int type) {
                                   extension == ".ppm" || extension == ".pnm";
   // OpenCV would convert silently: float depth in metres to PNG saturates to 0 or 1.
   if (float_data && !float_format) {
-    throw Error("cannot write floating-point data to '" + path + "': " +
-                (extension.empty() ? std::string("no extension") : extension) +
+    throw Error("cannot write floating-point data to '" + path +
+                "': " + (extension.empty() ? std::string("no extension") : extension) +
                 " holds only integers; use .tiff");
   }
   if (depth == CV_16U && !sixteen_bit_format) {
-    throw Error("cannot write 16-bit data to '" + path + "': " +
-                (extension.empty() ? std::string("no extension") : extension) +
+    throw Error("cannot write 16-bit data to '" + path +
+                "': " + (extension.empty() ? std::string("no extension") : extension) +
                 " holds only 8 bits; use .png or .tiff");
   }
 }

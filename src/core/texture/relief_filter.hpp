@@ -21,18 +21,20 @@ class ReliefFilter {
   /// Why the slopes and not the height: integration is linear, so away from the border this is
   /// the same high-pass of the height; at the border, a mirrored blur reproduces a locally
   /// constant function but not a ramp, and drift is a ramp in height but nearly constant in
-  /// slope. Blurs through the cosine transform, so the cost does not grow with the cutoff.
+  /// slope.
+  ///
+  /// The low-pass is smooth, so it is computed on a grid `factor` times coarser (box
+  /// averages, factor = sigma / 3 texels, at most 8), blurred through the cosine transform there
+  /// and interpolated back bilinearly: a 2048^2 island costs a few transforms of 512^2.
   void removeLongWavelengths(cv::Mat1f& dx, cv::Mat1f& dy, const cv::Mat1b& mask,
                              double cutoff_texels);
 
  private:
-  /// In place on a transform-sized matrix: Gaussian blur in the cosine domain.
+  /// In place on a transform-sized matrix: Gaussian blur (sigma in its own texels).
   void blur(cv::Mat1f& values, double sigma);
-  /// Subtracts the normalised-convolution low-pass of `slope` (weights: blurred mask, or none).
-  void highPass(cv::Mat1f& slope, const cv::Mat1b& mask, const cv::Mat1f& weights, double sigma);
 
   CosineTransform transform_;
-  ScratchBuffer<float> values_, weights_;
+  ScratchBuffer<float> sum_x_, sum_y_, weight_;
 };
 
 }  // namespace detail
