@@ -47,7 +47,7 @@ constexpr const char* kUsage =
     "          for the mesh's UVs at its true millimetre scale (a mesh without UVs is unwrapped\n"
     "          first), with config/materials/NAME.yaml's parameters, range and beta.\n"
     "  --beta: texture depth in mm (default: the material's, else 0.2 when a texture is given;\n"
-    "          0 = textureless).\n"
+    "          0 = textureless, nothing is baked).\n"
     "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
     "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
     "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
@@ -200,7 +200,11 @@ int run(int argc, char** argv) {
   if (args.flag("--sheet")) return renderSheet(args, model, mesh, output);
   std::shared_ptr<const norm2tex::HeightAtlas> atlas;
   double default_beta = 0.2;
-  if (const auto material = args.value("--material")) {
+  // --beta 0 is a textureless render: nothing to generate or bake.
+  const bool textureless = args.has("--beta") && args.number("--beta", 0.0) == 0.0;
+  if (textureless) {
+    // No texture to load.
+  } else if (const auto material = args.value("--material")) {
     // The material is generated for this mesh's own UV layout, so its scale in mm is right.
     const norm2tex::MaterialConfig config =
         norm2tex::loadMaterialConfig(norm2tex::cli::materialConfigPath(*material));

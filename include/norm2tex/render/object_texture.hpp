@@ -32,7 +32,10 @@ struct ObjectTexture {
 };
 
 /// A normal map (baked through the AtlasCache), an atlas file, or with neither the mesh's own
-/// normal texture. Throws Error naming the file, or when `source` names a material.
+/// normal texture: a file next to the mesh (cached) or embedded in it (GLB "*N", baked from
+/// memory). Throws Error naming the file for a given normal map or atlas, or when `source`
+/// names a material; the mesh's own texture, when missing or unusable, gives no atlas and a
+/// warning naming it as the mesh's normal texture (the mesh still renders).
 ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& mesh);
 
 /// Loads or bakes the texture. A procedural material is generated for `mesh`'s UV layout (a mesh

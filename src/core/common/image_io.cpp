@@ -38,18 +38,22 @@ cv::Mat readImage(const std::string& path, int flags, const std::string& what) {
     file.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     if (!file || ec) throw Error(what + " '" + path + "' cannot be read");
   }
+  return decodeImage(bytes, flags, what + " '" + path + "'");
+}
+
+cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags, const std::string& what) {
+  if (bytes.empty()) throw Error(what + " is empty");
   if (const std::string reason = detail::incompleteImageReason(bytes); !reason.empty()) {
-    throw Error(what + " '" + path + "' is corrupt: " + reason);
+    throw Error(what + " is corrupt: " + reason);
   }
   cv::Mat image;
   try {
     image = cv::imdecode(bytes, flags);
   } catch (const cv::Exception& e) {
-    throw Error(what + " '" + path + "' cannot be decoded: " + e.what());
+    throw Error(what + " cannot be decoded: " + e.what());
   }
   if (image.empty()) {
-    throw Error(what + " '" + path +
-                "' cannot be decoded (corrupt, truncated or not a PNG/JPEG/TIFF image)");
+    throw Error(what + " cannot be decoded (corrupt, truncated or not a PNG/JPEG/TIFF image)");
   }
   return image;
 }

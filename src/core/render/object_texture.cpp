@@ -11,6 +11,21 @@
 #include "norm2tex/texture/atlas_cache.hpp"
 
 namespace norm2tex {
+namespace {
+
+/// A normal map file through the AtlasCache.
+ObjectTexture bakeCached(const std::string& path, const BakeOptions& options,
+                         const std::string& what) {
+  ObjectTexture out;
+  const AtlasCache cache(AtlasCache::defaultDirectory());
+  AtlasCache::Result result = cache.loadOrBake(path, "", options);
+  out.warning = result.store_error;
+  out.atlas = std::make_shared<HeightAtlas>(std::move(result.atlas));
+  out.description = what + path + (result.was_cached ? " (cached)" : " (baked)");
+  return out;
+}
+
+}  // namespace
 
 ObjectTexture loadObjectTexture(const TextureSource& source, TexturedMesh& mesh) {
   const int given =
@@ -68,17 +83,33 @@ ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& m
     out.description = "atlas " + source.atlas;
     return out;
   }
-  const std::string normal_map =
-      source.normal_map.empty() ? mesh.normalTexturePath() : source.normal_map;
-  if (normal_map.empty()) return out;
   BakeOptions options;
   options.normal_map.convention = source.convention;
-  const AtlasCache cache(AtlasCache::defaultDirectory());
-  AtlasCache::Result result = cache.loadOrBake(normal_map, "", options);
-  out.warning = result.store_error;
-  out.atlas = std::make_shared<HeightAtlas>(std::move(result.atlas));
-  out.description = "normal map " + normal_map + (result.was_cached ? " (cached)" : " (baked)");
-  return out;
+  if (!source.normal_map.empty()) return bakeCached(source.normal_map, options, "normal map ");
+  // The mesh's own normal texture: a problem with it is a warning, the mesh still renders.
+  const std::string& reference = mesh.normalTextureReference();
+  if (reference.empty()) return out;
+  const std::string what = "the mesh's normal texture '" + reference + "'";
+  try {
+    if (!mesh.normalTexturePath().empty()) {
+      return bakeCached(mesh.normalTexturePath(), options, "the mesh's normal texture ");
+    }
+    if (mesh.embeddedNormalTexture().empty()) {
+      out.warning = what + " is embedded in a form that is not supported (only PNG/JPEG/TIFF " +
+                    "files are); rendering without texture";
+      return out;
+    }
+    // Embedded (GLB "*N", data URI): baked from memory, not cached (no file to key on).
+    const cv::Mat image = decodeImage(mesh.embeddedNormalTexture(), cv::IMREAD_UNCHANGED, what);
+    out.atlas = std::make_shared<HeightAtlas>(
+        bakeHeightAtlas(NormalMap::fromImage(image, options.normal_map), options));
+    out.description = "embedded normal texture " + reference + " (baked)";
+    return out;
+  } catch (const Error& e) {
+    out = ObjectTexture();
+    out.warning = what + " cannot be used (" + e.what() + "); rendering without texture";
+    return out;
+  }
 }
 
 }  // namespace norm2tex
