@@ -81,8 +81,8 @@ TEST_F(RenderCli, SheetHasOneRowPerTextureAndOneColumnPerPress) {
 }
 
 TEST_F(RenderCli, FloatDepthToAnEightBitFormatIsRefusedBeforeAnyOutput) {
-  const CliRun run = render(std::string(kBall) + " -o " + path("frame.png") + " --depth-out " +
-                            path("depth.png"));
+  const CliRun run =
+      render(std::string(kBall) + " -o " + path("frame.png") + " --depth-out " + path("depth.png"));
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(run.output.find("depth.png"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find(".tiff"), std::string::npos) << "names the format to use";
@@ -96,9 +96,9 @@ TEST_F(RenderCli, AtlasNaNTexelsAreInvalidAndInfiniteOnesAnError) {
   cv::Mat1f atlas(64, 64, 1.0f);
   atlas(cv::Rect(0, 0, 32, 64)).setTo(std::numeric_limits<float>::quiet_NaN());
   cv::imwrite(path("nan.tiff"), atlas);
-  const CliRun run = render(std::string(kBall) + " --atlas " + path("nan.tiff") +
-                            " --beta 0.2 -o " + path("frame.png") + " --depth-out " +
-                            path("depth.tiff"));
+  const CliRun run =
+      render(std::string(kBall) + " --atlas " + path("nan.tiff") + " --beta 0.2 -o " +
+             path("frame.png") + " --depth-out " + path("depth.tiff"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const cv::Mat depth = cv::imread(path("depth.tiff"), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(depth.type(), CV_32FC1);
@@ -109,8 +109,8 @@ TEST_F(RenderCli, AtlasNaNTexelsAreInvalidAndInfiniteOnesAnError) {
 
   atlas(cv::Rect(40, 10, 3, 3)).setTo(std::numeric_limits<float>::infinity());
   cv::imwrite(path("inf.tiff"), atlas);
-  const CliRun bad = render(std::string(kBall) + " --atlas " + path("inf.tiff") + " -o " +
-                            path("bad.png"));
+  const CliRun bad =
+      render(std::string(kBall) + " --atlas " + path("inf.tiff") + " -o " + path("bad.png"));
   EXPECT_EQ(bad.exit_code, 1) << bad.output;
   EXPECT_NE(bad.output.find("infinite"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(path("bad.png")));
