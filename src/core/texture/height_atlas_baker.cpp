@@ -6,6 +6,7 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
+#include "texture/bake_stages.hpp"
 #include "texture/masked_gaussian.hpp"
 #include "texture/relief_filter.hpp"
 #include "texture/scratch_buffer.hpp"
@@ -111,20 +112,22 @@ void validate(const BakeOptions& options) {
   }
 }
 
-HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& options,
-                            const BakeProgress& progress, BakeReport* report) {
+namespace detail {
+
+cv::Mat1f integrateIslands(const NormalMap& normal_map, const UvIslands& islands,
+                           const BakeOptions& options, const BakeProgress& progress,
+                           BakeReport& summary) {
   validate(options);
-  UvIslands islands = findUvIslands(normal_map.valid());
   if (islands.islands.empty()) {
     throw Error("the normal map has no valid texel (all masked by alpha, mask or nz <= " +
                 std::to_string(options.normal_map.min_nz) + ")");
   }
-  const int valid_texels = normal_map.validCount();
+  long total = 0;
+  for (const UvIsland& island : islands.islands) total += island.texel_count;
   cv::Mat1f global;
   createWithHugePages(global, normal_map.rows(), normal_map.cols());
   global.setTo(0.0f);
   BakeWorkspace workspace(options.integration);
-  BakeReport summary;
   long done = 0;
   for (const UvIsland& island : islands.islands) {
     const cv::Rect box = island.bounding_box;
@@ -139,23 +142,39 @@ HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& opti
         std::max(summary.worst_relative_residual, integration.relative_residual);
     if (!integration.converged) ++summary.unconverged_islands;
     done += island.texel_count;
-    if (progress) progress(static_cast<double>(done) / valid_texels);
-  }
-
-  const cv::Vec2f low_high = maskedPercentiles(global, normal_map.valid(), options.percentile_low,
-                                               options.percentile_high);
-  if (options.physical_scale) {
-    toPhysicalScale(global, normal_map.valid(), low_high, options);
-  } else {
-    normalizeToRange(global, normal_map.valid(), low_high, options.range);
+    if (progress) progress(static_cast<double>(done) / total);
   }
   summary.island_count = static_cast<int>(islands.islands.size());
-  summary.valid_texels = valid_texels;
-  summary.percentile_values = low_high;
+  summary.valid_texels = static_cast<int>(total);
   summary.relief_cutoff_texels = reliefCutoffTexels(options);
+  return global;
+}
+
+HeightAtlas finishAtlas(cv::Mat1f global, cv::Mat1b valid, cv::Mat1i labels,
+                        const BakeOptions& options, BakeReport& summary) {
+  const cv::Vec2f low_high =
+      maskedPercentiles(global, valid, options.percentile_low, options.percentile_high);
+  if (options.physical_scale) {
+    toPhysicalScale(global, valid, low_high, options);
+  } else {
+    normalizeToRange(global, valid, low_high, options.range);
+  }
+  summary.percentile_values = low_high;
   summary.relief_amplitude_mm = (low_high[1] - low_high[0]) * options.mm_per_texel;
+  return HeightAtlas(std::move(global), std::move(valid), std::move(labels));
+}
+
+}  // namespace detail
+
+HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& options,
+                            const BakeProgress& progress, BakeReport* report) {
+  UvIslands islands = findUvIslands(normal_map.valid());
+  BakeReport summary;
+  cv::Mat1f global = detail::integrateIslands(normal_map, islands, options, progress, summary);
+  HeightAtlas atlas = detail::finishAtlas(std::move(global), normal_map.valid().clone(),
+                                          std::move(islands.labels), options, summary);
   if (report != nullptr) *report = summary;
-  return HeightAtlas(std::move(global), normal_map.valid().clone(), std::move(islands.labels));
+  return atlas;
 }
 
 }  // namespace norm2tex
