@@ -12,7 +12,9 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/common/image_io.hpp"
+#include "norm2tex/mesh/textured_mesh.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/mesh_bake.hpp"
 #include "norm2tex/texture/relief_spectrum.hpp"
 #include "quiet_stderr.hpp"
 
@@ -26,7 +28,7 @@ constexpr const char* kUsage =
     "neumann|periodic]\n"
     "                     [--tolerance T] [--max-iterations N]\n"
     "                     [--relief-cutoff-texels N | --relief-cutoff-mm MM] [--mm-per-texel MM]\n"
-    "                     [--physical] [--paper-exact] [--quiet]\n"
+    "                     [--physical] [--paper-exact] [--mesh M [--scale S]] [--quiet]\n"
     "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels NaN)\n"
     "  OUT.png:       8-bit preview, the range's low end black and high end white\n"
     "  Defaults are the paper's: convention opengl, range -1,1, alpha 0.2, sigma-fine 0.35,\n"
@@ -35,7 +37,10 @@ constexpr const char* kUsage =
     "  (0 = keep all).\n"
     "  --mm-per-texel: millimetres of surface per texel; with --physical H_global is in mm\n"
     "                  (the relief the normal map implies) and beta becomes a gain.\n"
-    "  --paper-exact:  the paper's bake only (no high-pass, no mean-slope removal, periodic).\n";
+    "  --paper-exact:  the paper's bake only (no high-pass, no mean-slope removal, periodic).\n"
+    "  --mesh M [--scale S]: the texture's mesh: its UV charts are the islands (texels outside\n"
+    "                  every chart invalid), its UV scale gives mm per texel, and islands get\n"
+    "                  offsets that make heights agree across the mesh's seams.\n";
 
 using Clock = std::chrono::steady_clock;
 
@@ -76,7 +81,10 @@ norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
   } else {
     throw norm2tex::Error("unknown --boundary '" + boundary + "'; valid: neumann, periodic");
   }
-  norm2tex::validate(options);
+  // With --mesh, mm per texel comes from the mesh (checked when it is known).
+  norm2tex::BakeOptions checked = options;
+  if (args.has("--mesh") && checked.mm_per_texel == 0.0) checked.physical_scale = false;
+  norm2tex::validate(checked);
   return options;
 }
 
@@ -103,7 +111,8 @@ int run(int argc, char** argv) {
       argc, argv,
       {"-o", "--output", "--mask", "--convention", "--range", "--alpha", "--sigma-fine",
        "--sigma-coarse", "--percentile-low", "--percentile-high", "--boundary", "--tolerance",
-       "--max-iterations", "--relief-cutoff-texels", "--relief-cutoff-mm", "--mm-per-texel"},
+       "--max-iterations", "--relief-cutoff-texels", "--relief-cutoff-mm", "--mm-per-texel",
+       "--mesh", "--scale"},
       {"--quiet", "-h", "--help", "--physical", "--paper-exact"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
@@ -143,8 +152,19 @@ int run(int argc, char** argv) {
 
   const auto bake_start = Clock::now();
   norm2tex::BakeReport report;
-  const norm2tex::HeightAtlas atlas = norm2tex::bakeHeightAtlas(
-      normal_map, options, show_progress ? norm2tex::BakeProgress(progress) : nullptr, &report);
+  norm2tex::MeshBakeReport mesh_report;
+  const norm2tex::BakeProgress shown = show_progress ? norm2tex::BakeProgress(progress) : nullptr;
+  norm2tex::HeightAtlas atlas;
+  if (const auto mesh_path = args.value("--mesh")) {
+    // The mesh's UV charts are the islands, its scale sets mm per texel, seams are matched.
+    norm2tex::MeshLoadOptions mesh_options;
+    mesh_options.scale = args.number("--scale", 1.0);
+    const norm2tex::TexturedMesh mesh = norm2tex::TexturedMesh::load(*mesh_path, mesh_options);
+    atlas = norm2tex::bakeHeightAtlasForMesh(normal_map, mesh, options, shown, &mesh_report);
+    report = mesh_report.bake;
+  } else {
+    atlas = norm2tex::bakeHeightAtlas(normal_map, options, shown, &report);
+  }
   const double bake_seconds = secondsSince(bake_start);
 
   if (extension == ".png") {
@@ -168,10 +188,17 @@ int run(int argc, char** argv) {
     std::printf(
         "%.0f %% of H_global's variance at wavelengths above 64 texels\n",
         100.0 * norm2tex::longWavelengthVarianceFraction(atlas.heights(), atlas.valid(), 64.0));
-    if (options.mm_per_texel > 0.0) {
+    if (args.has("--mesh")) {
+      std::printf(
+          "mesh: %d UV charts, %.4g mm per texel; %d seam edges, step across seams %.1f%% -> "
+          "%.1f%% of the relief amplitude after island offsets\n",
+          mesh_report.chart_count, mesh_report.mm_per_texel, mesh_report.seams.seam_edges,
+          100.0 * mesh_report.seams.step_before, 100.0 * mesh_report.seams.step_after);
+    }
+    if (options.mm_per_texel > 0.0 || mesh_report.mm_per_texel > 0.0) {
       std::printf("implied relief amplitude %.4g mm (percentiles %.2f..%.2f at %.4g mm/texel)%s\n",
                   report.relief_amplitude_mm, options.percentile_low, options.percentile_high,
-                  options.mm_per_texel,
+                  options.mm_per_texel > 0.0 ? options.mm_per_texel : mesh_report.mm_per_texel,
                   options.physical_scale ? "; H_global in mm, use beta as a gain (1)" : "");
     }
     if (report.unconverged_islands > 0) {

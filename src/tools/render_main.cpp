@@ -46,8 +46,9 @@ constexpr const char* kUsage =
     "  --material NAME: a procedural material (wood, fabric, rock, smooth, print3d) generated\n"
     "          for the mesh's UVs at its true millimetre scale (a mesh without UVs is unwrapped\n"
     "          first), with config/materials/NAME.yaml's parameters, range and beta.\n"
-    "  --beta: texture depth in mm (default: the material's, else 0.2 when a texture is given;\n"
-    "          0 = textureless, nothing is baked).\n"
+    "  --beta: texture depth in mm (default: the material's; 1, a gain, for the mesh's own\n"
+    "          texture, baked in mm from the mesh's UV scale; else 0.2 mm; 0 = textureless,\n"
+    "          nothing is baked).\n"
     "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
     "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
     "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
@@ -86,13 +87,18 @@ Eigen::Isometry3d parsePose(const std::string& text, double press_mm) {
   return pose;
 }
 
-std::shared_ptr<const norm2tex::HeightAtlas> loadTexture(norm2tex::TextureSource source,
-                                                         const norm2tex::TexturedMesh& mesh) {
-  const norm2tex::ObjectTexture texture = norm2tex::loadTextureFile(source, mesh);
+norm2tex::ObjectTexture loadTextureWithWarning(norm2tex::TextureSource source,
+                                               const norm2tex::TexturedMesh& mesh) {
+  norm2tex::ObjectTexture texture = norm2tex::loadTextureFile(source, mesh);
   if (!texture.warning.empty()) {
     std::fprintf(stderr, "norm2tex_render: warning: %s\n", texture.warning.c_str());
   }
-  return texture.atlas;
+  return texture;
+}
+
+std::shared_ptr<const norm2tex::HeightAtlas> loadTexture(norm2tex::TextureSource source,
+                                                         const norm2tex::TexturedMesh& mesh) {
+  return loadTextureWithWarning(std::move(source), mesh).atlas;
 }
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -104,12 +110,12 @@ std::vector<std::string> splitList(const std::string& text) {
   return items;
 }
 
-std::shared_ptr<const norm2tex::HeightAtlas> loadAtlas(const norm2tex::cli::Arguments& args,
-                                                       const norm2tex::TexturedMesh& mesh) {
+norm2tex::ObjectTexture loadAtlas(const norm2tex::cli::Arguments& args,
+                                  const norm2tex::TexturedMesh& mesh) {
   norm2tex::TextureSource source;
   source.atlas = args.value("--atlas", "");
   if (source.atlas.empty()) source.normal_map = args.value("--normal-map", "");
-  return loadTexture(source, mesh);
+  return loadTextureWithWarning(source, mesh);
 }
 
 /// --sheet: rows = no texture, then each normal map; columns = press depths.
@@ -219,7 +225,11 @@ int run(int argc, char** argv) {
     default_beta = config.beta_mm;
   } else {
     const norm2tex::cli::QuietStderr quiet_decoders;
-    atlas = loadAtlas(args, *mesh);
+    const norm2tex::ObjectTexture texture = loadAtlas(args, *mesh);
+    atlas = texture.atlas;
+    // A mesh's own texture comes at physical scale (mm): its beta is a gain of 1.
+    if (texture.beta_mm > 0.0) default_beta = texture.beta_mm;
+    if (atlas) std::printf("texture: %s\n", texture.description.c_str());
   }
   const double beta = args.number("--beta", atlas ? default_beta : 0.0);
 

@@ -14,6 +14,7 @@
 #include "norm2tex/render/tactile_renderer.hpp"
 #include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/mesh_bake.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 #include "test_helpers.hpp"
 
@@ -110,14 +111,24 @@ TEST(ObjectTexture, EmbeddedGlbNormalTextureIsBakedAndRendersTextured) {
   const ObjectTexture texture = loadTextureFile({}, *mesh);
   ASSERT_NE(texture.atlas, nullptr) << texture.warning;
   EXPECT_TRUE(texture.warning.empty()) << texture.warning;
-  EXPECT_NE(texture.description.find("embedded"), std::string::npos) << texture.description;
-  // The same texels as baking the PNG as a file.
-  const HeightAtlas direct =
-      bakeHeightAtlas(NormalMap::fromImage(cv::imdecode(png, cv::IMREAD_UNCHANGED)));
+  EXPECT_NE(texture.description.find("normal texture *0"), std::string::npos)
+      << texture.description;
+  // The same texels as baking the PNG for this mesh: its chart, its scale, millimetres.
+  BakeOptions physical;
+  physical.physical_scale = true;
+  MeshBakeReport report;
+  const HeightAtlas direct = bakeHeightAtlasForMesh(
+      NormalMap::fromImage(cv::imdecode(png, cv::IMREAD_UNCHANGED)), *mesh, physical, {}, &report);
   EXPECT_EQ(cv::norm(texture.atlas->heights(), direct.heights(), cv::NORM_INF), 0.0);
+  EXPECT_TRUE(texture.physical_scale);
+  EXPECT_EQ(texture.beta_mm, 1.0) << "heights in mm: beta is a gain";
+  EXPECT_NEAR(report.mm_per_texel, 20.0 / 128.0, 1e-3) << "20 mm over 128 texels";
+  // Ridges of 1 texel height on a 0.156 mm grid: the relief is about 0.16 mm.
+  EXPECT_GT(report.bake.relief_amplitude_mm, 0.05);
+  EXPECT_LT(report.bake.relief_amplitude_mm, 0.5);
 
   TactileRenderer renderer(makeDigitSensorModel());
-  renderer.setObject(mesh, texture.atlas, 0.2);
+  renderer.setObject(mesh, texture.atlas, texture.beta_mm);
   const TactileFrame textured = renderer.render(pressed(0.3), -1);
   EXPECT_TRUE(textured.textured);
   const cv::Mat3b textured_image = textured.image.clone();

@@ -1,6 +1,7 @@
 #include "norm2tex/render/object_texture.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -9,6 +10,7 @@
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/material_texture.hpp"
 #include "norm2tex/texture/atlas_cache.hpp"
+#include "norm2tex/texture/mesh_bake.hpp"
 
 namespace norm2tex {
 namespace {
@@ -91,19 +93,39 @@ ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& m
   if (reference.empty()) return out;
   const std::string what = "the mesh's normal texture '" + reference + "'";
   try {
+    cv::Mat image;
     if (!mesh.normalTexturePath().empty()) {
-      return bakeCached(mesh.normalTexturePath(), options, "the mesh's normal texture ");
-    }
-    if (mesh.embeddedNormalTexture().empty()) {
+      if (!mesh.hasUvs()) {
+        return bakeCached(mesh.normalTexturePath(), options, "the mesh's normal texture ");
+      }
+      image = readImage(mesh.normalTexturePath(), cv::IMREAD_UNCHANGED, what);
+    } else if (mesh.embeddedNormalTexture().empty()) {
       out.warning = what + " is embedded in a form that is not supported (only PNG/JPEG/TIFF " +
                     "files are); rendering without texture";
       return out;
+    } else {
+      image = decodeImage(mesh.embeddedNormalTexture(), cv::IMREAD_UNCHANGED, what);
     }
-    // Embedded (GLB "*N", data URI): baked from memory, not cached (no file to key on).
-    const cv::Mat image = decodeImage(mesh.embeddedNormalTexture(), cv::IMREAD_UNCHANGED, what);
+    const NormalMap normal_map = NormalMap::fromImage(image, options.normal_map);
+    if (!mesh.hasUvs()) {
+      out.atlas = std::make_shared<HeightAtlas>(bakeHeightAtlas(normal_map, options));
+      out.description = "embedded normal texture " + reference + " (baked)";
+      return out;
+    }
+    // The mesh's own texture on the mesh: its charts, its scale, heights in mm.
+    options.physical_scale = true;
+    MeshBakeReport report;
     out.atlas = std::make_shared<HeightAtlas>(
-        bakeHeightAtlas(NormalMap::fromImage(image, options.normal_map), options));
-    out.description = "embedded normal texture " + reference + " (baked)";
+        bakeHeightAtlasForMesh(normal_map, mesh, options, {}, &report));
+    out.beta_mm = 1.0;
+    out.physical_scale = true;
+    char note[256];
+    std::snprintf(note, sizeof(note),
+                  " (baked on %d UV charts, %.3g mm per texel, relief amplitude %.3g mm, seam "
+                  "step %.1f%% -> %.1f%%)",
+                  report.chart_count, report.mm_per_texel, report.bake.relief_amplitude_mm,
+                  100.0 * report.seams.step_before, 100.0 * report.seams.step_after);
+    out.description = "the mesh's normal texture " + reference + note;
     return out;
   } catch (const Error& e) {
     out = ObjectTexture();
