@@ -59,6 +59,7 @@ class FrankotChellappaIntegrator {
   FrankotChellappaIntegrator& operator=(FrankotChellappaIntegrator&&) noexcept;
 
   /// Writes the height into `height` (reallocated unless it already has dx's size and type).
+  /// `height` may be `dx` or `dy` itself: the slopes are read in full before it is written.
   /// Throws Error on empty or mismatched input.
   void integrate(const cv::Mat1f& dx, const cv::Mat1f& dy, const cv::Mat1b& mask, cv::Mat1f& height,
                  IntegrationReport* report = nullptr);
