@@ -21,7 +21,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: norm2tex_make_demo_normal_map -o OUT.png [--size PX] [--bits 8|16]\n"
     "                                     [--convention opengl|directx] [--height-out H.tiff]\n"
-    "                                     [--scan-like [--seed S]]\n"
+    "                                     [--one-island | --scan-like [--seed S]]\n"
+    "  --one-island: the same relief without alpha: every texel valid, one UV island.\n"
     "  --scan-like: one island of random fine relief (wavelengths 3-40 texels) whose slopes\n"
     "               carry a weak smooth bias (hundreds of texels), as photographed or scanned\n"
     "               normal maps do; integrated, the bias becomes long-wavelength drift.\n";
@@ -57,7 +58,7 @@ norm2tex::AnalyticSurface scanLikeSurface(int size, std::uint64_t seed) {
 int run(int argc, char** argv) {
   const norm2tex::cli::Arguments args(
       argc, argv, {"-o", "--size", "--bits", "--convention", "--height-out", "--seed"},
-      {"-h", "--help", "--scan-like"});
+      {"-h", "--help", "--scan-like", "--one-island"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
     return 0;
@@ -100,14 +101,15 @@ int run(int argc, char** argv) {
   islands.convertTo(alpha, normals.depth(), bits == 8 ? 1.0 : 257.0);
   cv::Mat bgra;
   cv::merge(std::vector<cv::Mat>{normals, alpha}, bgra);
-  norm2tex::writeImage(output, bgra);
+  norm2tex::writeImage(output, args.flag("--one-island") ? normals : bgra);
   if (const auto height_out = args.value("--height-out")) {
     cv::Mat1f height = surface.height.clone();
     height.setTo(0.0f, islands == 0);
     norm2tex::writeImage(*height_out, height);
   }
-  std::printf("wrote %s (%dx%d, %d-bit RGBA, %s, 4 UV islands)\n", output.c_str(), size, size, bits,
-              norm2tex::toString(convention).c_str());
+  std::printf("wrote %s (%dx%d, %d-bit, %s, %s)\n", output.c_str(), size, size, bits,
+              norm2tex::toString(convention).c_str(),
+              args.flag("--one-island") ? "RGB, one UV island" : "RGBA, 4 UV islands");
   return 0;
 }
 
