@@ -48,6 +48,8 @@ void ReliefFilter::removeLongWavelengths(cv::Mat1f& dx, cv::Mat1f& dy, const cv:
   sum_x.setTo(0.0f);
   sum_y.setTo(0.0f);
   weight.setTo(0.0f);
+  std::vector<int> cell(mask.cols);  // coarse column of each column (no division per texel)
+  for (int c = 0; c < mask.cols; ++c) cell[c] = c / factor;
   for (int r = 0; r < mask.rows; ++r) {
     const uchar* in = mask.ptr<uchar>(r);
     const float* gx = dx.ptr<float>(r);
@@ -57,9 +59,9 @@ void ReliefFilter::removeLongWavelengths(cv::Mat1f& dx, cv::Mat1f& dy, const cv:
     float* w = weight.ptr<float>(r / factor);
     for (int c = 0; c < mask.cols; ++c) {
       if (!in[c]) continue;
-      sx[c / factor] += gx[c];
-      sy[c / factor] += gy[c];
-      w[c / factor] += 1.0f;
+      sx[cell[c]] += gx[c];
+      sy[cell[c]] += gy[c];
+      w[cell[c]] += 1.0f;
     }
   }
   const double coarse_sigma = sigma / factor;
