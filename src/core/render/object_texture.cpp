@@ -27,6 +27,17 @@ ObjectTexture bakeCached(const std::string& path, const BakeOptions& options,
   return out;
 }
 
+/// " (baked on N UV charts, ... mm per texel, relief amplitude ..., seam step a% -> b%)".
+std::string describeMeshBake(const MeshBakeReport& report) {
+  char note[256];
+  std::snprintf(note, sizeof(note),
+                " (baked on %d UV charts, %.3g mm per texel, relief amplitude %.3g mm, seam "
+                "step %.1f%% -> %.1f%%)",
+                report.chart_count, report.mm_per_texel, report.bake.relief_amplitude_mm,
+                100.0 * report.seams.step_before, 100.0 * report.seams.step_after);
+  return note;
+}
+
 }  // namespace
 
 ObjectTexture loadObjectTexture(const TextureSource& source, TexturedMesh& mesh) {
@@ -93,39 +104,40 @@ ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& m
   if (reference.empty()) return out;
   const std::string what = "the mesh's normal texture '" + reference + "'";
   try {
-    cv::Mat image;
+    // The mesh's own texture on the mesh: its charts, its scale, heights in mm, beta 1.
+    BakeOptions for_mesh = options;
+    for_mesh.physical_scale = mesh.hasUvs();
     if (!mesh.normalTexturePath().empty()) {
       if (!mesh.hasUvs()) {
         return bakeCached(mesh.normalTexturePath(), options, "the mesh's normal texture ");
       }
-      image = readImage(mesh.normalTexturePath(), cv::IMREAD_UNCHANGED, what);
+      const AtlasCache cache(AtlasCache::defaultDirectory());
+      AtlasCache::Result result =
+          cache.loadOrBake(mesh.normalTexturePath(), "", for_mesh, {}, &mesh);
+      out.warning = result.store_error;
+      out.atlas = std::make_shared<HeightAtlas>(std::move(result.atlas));
+      out.description = "the mesh's normal texture " + reference +
+                        (result.was_cached ? " (cached)" : describeMeshBake(result.mesh_report));
     } else if (mesh.embeddedNormalTexture().empty()) {
       out.warning = what + " is embedded in a form that is not supported (only PNG/JPEG/TIFF " +
                     "files are); rendering without texture";
       return out;
     } else {
-      image = decodeImage(mesh.embeddedNormalTexture(), cv::IMREAD_UNCHANGED, what);
+      // Embedded (GLB "*N", data URI): baked from memory, not cached (no file to key on).
+      const NormalMap normal_map = NormalMap::fromImage(
+          decodeImage(mesh.embeddedNormalTexture(), cv::IMREAD_UNCHANGED, what),
+          options.normal_map);
+      MeshBakeReport report;
+      out.atlas = std::make_shared<HeightAtlas>(
+          mesh.hasUvs() ? bakeHeightAtlasForMesh(normal_map, mesh, for_mesh, {}, &report)
+                        : bakeHeightAtlas(normal_map, options));
+      out.description = "the mesh's normal texture " + reference +
+                        (mesh.hasUvs() ? describeMeshBake(report) : std::string(" (baked)"));
     }
-    const NormalMap normal_map = NormalMap::fromImage(image, options.normal_map);
-    if (!mesh.hasUvs()) {
-      out.atlas = std::make_shared<HeightAtlas>(bakeHeightAtlas(normal_map, options));
-      out.description = "embedded normal texture " + reference + " (baked)";
-      return out;
+    if (mesh.hasUvs()) {
+      out.beta_mm = 1.0;
+      out.physical_scale = true;
     }
-    // The mesh's own texture on the mesh: its charts, its scale, heights in mm.
-    options.physical_scale = true;
-    MeshBakeReport report;
-    out.atlas = std::make_shared<HeightAtlas>(
-        bakeHeightAtlasForMesh(normal_map, mesh, options, {}, &report));
-    out.beta_mm = 1.0;
-    out.physical_scale = true;
-    char note[256];
-    std::snprintf(note, sizeof(note),
-                  " (baked on %d UV charts, %.3g mm per texel, relief amplitude %.3g mm, seam "
-                  "step %.1f%% -> %.1f%%)",
-                  report.chart_count, report.mm_per_texel, report.bake.relief_amplitude_mm,
-                  100.0 * report.seams.step_before, 100.0 * report.seams.step_after);
-    out.description = "the mesh's normal texture " + reference + note;
     return out;
   } catch (const Error& e) {
     out = ObjectTexture();

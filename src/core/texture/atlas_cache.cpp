@@ -59,11 +59,22 @@ std::string AtlasCache::defaultDirectory() {
 }
 
 std::string AtlasCache::key(const std::string& normal_map_path, const std::string& mask_path,
-                            const BakeOptions& options) const {
+                            const BakeOptions& options, const TexturedMesh* mesh) const {
   std::uint64_t hash = fnv1a64("norm2tex-atlas-v" + std::to_string(kFormatVersion));
   hash = fnv1a64(hashFile(normal_map_path), hash);
   hash = fnv1a64(mask_path.empty() ? std::string("no-mask") : hashFile(mask_path), hash);
   hash = fnv1a64(describeOptions(options), hash);
+  if (mesh != nullptr) {
+    // What a mesh bake depends on: UV layout (charts), 3-D areas (scale) and seams.
+    const auto bytes = [](const auto& items) {
+      return std::string(reinterpret_cast<const char*>(items.data()),
+                         items.size() * sizeof(items[0]));
+    };
+    hash = fnv1a64("mesh", hash);
+    hash = fnv1a64(bytes(mesh->vertices()), hash);
+    hash = fnv1a64(bytes(mesh->triangles()), hash);
+    hash = fnv1a64(bytes(mesh->uvs()), hash);
+  }
   return toHex(hash);
 }
 
@@ -145,17 +156,23 @@ void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
 
 AtlasCache::Result AtlasCache::loadOrBake(const std::string& normal_map_path,
                                           const std::string& mask_path, const BakeOptions& options,
-                                          const BakeProgress& progress) const {
-  validate(options);
+                                          const BakeProgress& progress,
+                                          const TexturedMesh* mesh) const {
+  // A mesh bake learns mm per texel from the mesh (and checks the physical scale then).
+  BakeOptions checked = options;
+  if (mesh != nullptr) checked.physical_scale = false;
+  validate(checked);
   Result result;
-  const std::string cache_key = key(normal_map_path, mask_path, options);
+  const std::string cache_key = key(normal_map_path, mask_path, options, mesh);
   if (std::optional<HeightAtlas> cached = load(cache_key)) {
     result.atlas = std::move(*cached);
     result.was_cached = true;
     return result;
   }
   const NormalMap normal_map = NormalMap::load(normal_map_path, options.normal_map, mask_path);
-  result.atlas = bakeHeightAtlas(normal_map, options, progress);
+  result.atlas = mesh != nullptr ? bakeHeightAtlasForMesh(normal_map, *mesh, options, progress,
+                                                          &result.mesh_report)
+                                 : bakeHeightAtlas(normal_map, options, progress);
   try {
     store(cache_key, result.atlas, normal_map_path, mask_path, options);
   } catch (const Error& e) {
