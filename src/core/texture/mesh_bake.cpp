@@ -8,6 +8,7 @@
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/mesh/uv_unwrap.hpp"
@@ -59,6 +60,8 @@ UvIslands splitCharts(const cv::Mat1i& charts, const cv::Mat1b& valid) {
 struct SeamSample {
   int island_a, island_b;
   float height_a, height_b;
+  Eigen::Vector2f uv_a, uv_b;
+  cv::Point texel_a, texel_b;  // the island texel each side's look-up leans on most
 };
 
 /// Edges of the mesh that are one edge in 3-D but two in UV (their triangles' corners share
@@ -90,7 +93,7 @@ std::vector<SeamSample> sampleSeams(const TexturedMesh& mesh, const HeightAtlas&
   const cv::Mat1i& labels = atlas.islandLabels();
   // The island HeightAtlas::sample draws from: that of the heaviest valid texel of the four
   // around the point (a seam runs along a chart's border, between texel centres).
-  const auto islandAt = [&](const Eigen::Vector2f& uv) {
+  const auto islandAt = [&](const Eigen::Vector2f& uv, cv::Point& texel) {
     const double u = uv.x() - std::floor(uv.x()), v = uv.y() - std::floor(uv.y());
     const double x = u * labels.cols - 0.5, y = (1.0 - v) * labels.rows - 0.5;
     const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
@@ -105,6 +108,7 @@ std::vector<SeamSample> sampleSeams(const TexturedMesh& mesh, const HeightAtlas&
         if (labels(r, c) != 0 && weight > best) {
           best = weight;
           best_label = labels(r, c);
+          texel = cv::Point(c, r);
         }
       }
     }
@@ -124,13 +128,14 @@ std::vector<SeamSample> sampleSeams(const TexturedMesh& mesh, const HeightAtlas&
       const float t = (s + 0.5f) / count;
       const Eigen::Vector2f uv_a = (1 - t) * a.uv_first + t * a.uv_second;
       const Eigen::Vector2f uv_b = (1 - t) * b.uv_first + t * b.uv_second;
-      const int island_a = islandAt(uv_a), island_b = islandAt(uv_b);
+      cv::Point texel_a, texel_b;
+      const int island_a = islandAt(uv_a, texel_a), island_b = islandAt(uv_b, texel_b);
       if (island_a == 0 || island_b == 0 || island_a == island_b) continue;
       bool valid_a = false, valid_b = false;
       const float height_a = atlas.sample(uv_a.x(), uv_a.y(), &valid_a);
       const float height_b = atlas.sample(uv_b.x(), uv_b.y(), &valid_b);
       if (!valid_a || !valid_b) continue;
-      samples.push_back({island_a, island_b, height_a, height_b});
+      samples.push_back({island_a, island_b, height_a, height_b, uv_a, uv_b, texel_a, texel_b});
       counted = true;
     }
     if (counted) ++seam_edges;
@@ -172,6 +177,72 @@ double rmsStep(const std::vector<SeamSample>& samples, const std::vector<double>
     sum += (a - b) * (a - b);
   }
   return std::sqrt(sum / samples.size());
+}
+
+/// Heights at both sides of every sample, looked up again in `atlas` (after corrections).
+void resample(std::vector<SeamSample>& samples, const HeightAtlas& atlas) {
+  for (SeamSample& sample : samples) {
+    sample.height_a = atlas.sample(sample.uv_a.x(), sample.uv_a.y());
+    sample.height_b = atlas.sample(sample.uv_b.x(), sample.uv_b.y());
+  }
+}
+
+/// Seam feathering: each island filters its relief on its own, so near a seam the two sides'
+/// low-passes differ in shape, a smooth mismatch no constant can remove. Each side takes half
+/// of the remaining difference at the seam, spread along the seam (normalised Gaussian of the
+/// seam samples) and fading with the distance from the seam (Gaussian of `sigma` texels, the
+/// high-pass's own scale, so only wavelengths the high-pass removes anyway are touched).
+void featherSeams(const std::vector<SeamSample>& samples, const UvIslands& islands, double sigma,
+                  cv::Mat1f& global) {
+  std::vector<std::vector<std::pair<cv::Point, float>>> per_island(islands.islands.size());
+  for (const SeamSample& s : samples) {
+    const float half = 0.5f * (s.height_a - s.height_b);
+    per_island[s.island_a - 1].emplace_back(s.texel_a, -half);
+    per_island[s.island_b - 1].emplace_back(s.texel_b, half);
+  }
+  const int radius = static_cast<int>(std::ceil(3.0 * sigma));
+  for (size_t i = 0; i < per_island.size(); ++i) {
+    if (per_island[i].empty()) continue;
+    const cv::Rect box = islands.islands[i].bounding_box;
+    cv::Mat1f value(box.size(), 0.0f), weight(box.size(), 0.0f);
+    cv::Mat1b off_seam(box.size(), uchar(255));
+    for (const auto& [texel, correction] : per_island[i]) {
+      const cv::Point p = texel - box.tl();
+      if (!box.contains(texel)) continue;
+      value(p) += correction;
+      weight(p) += 1.0f;
+      off_seam(p) = 0;
+    }
+    // Along the seam: the corrections' local mean (narrower, so it follows the seam).
+    const double along = std::max(0.5, 0.5 * sigma);
+    const cv::Size kernel(2 * static_cast<int>(std::ceil(3.0 * along)) + 1,
+                          2 * static_cast<int>(std::ceil(3.0 * along)) + 1);
+    cv::GaussianBlur(value, value, kernel, along, along, cv::BORDER_CONSTANT);
+    cv::GaussianBlur(weight, weight, kernel, along, along, cv::BORDER_CONSTANT);
+    cv::Mat1f distance;
+    cv::distanceTransform(off_seam, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    // Away from the seam: carry the nearest seam correction, faded by distance. The blurred
+    // correction is extended by normalised convolution at the fading scale.
+    cv::Mat1f wide_value, wide_weight;
+    const cv::Size wide(2 * radius + 1, 2 * radius + 1);
+    cv::GaussianBlur(value, wide_value, wide, sigma, sigma, cv::BORDER_CONSTANT);
+    cv::GaussianBlur(weight, wide_weight, wide, sigma, sigma, cv::BORDER_CONSTANT);
+    const int label = islands.islands[i].label;
+    for (int r = 0; r < box.height; ++r) {
+      const int* labels = islands.labels.ptr<int>(box.y + r);
+      float* h = global.ptr<float>(box.y + r);
+      for (int c = 0; c < box.width; ++c) {
+        if (labels[box.x + c] != label) continue;
+        const float d = distance(r, c);
+        const float fade = std::exp(static_cast<float>(-0.5 * d * d / (sigma * sigma)));
+        if (fade < 1e-4f) continue;
+        const float w = weight(r, c) > 1e-6f ? weight(r, c) : wide_weight(r, c);
+        const float v = weight(r, c) > 1e-6f ? value(r, c) : wide_value(r, c);
+        if (!(w > 1e-12f)) continue;
+        h[box.x + c] += fade * v / w;
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -228,10 +299,20 @@ HeightAtlas bakeHeightAtlasForMesh(const NormalMap& normal_map, const TexturedMe
         if (label[c] > 0) h[c] += static_cast<float>(offsets[label[c] - 1]);
       }
     }
+    std::vector<SeamSample> matched = samples;
+    for (SeamSample& s : matched) {
+      s.height_a += static_cast<float>(offsets[s.island_a - 1]);
+      s.height_b += static_cast<float>(offsets[s.island_b - 1]);
+    }
+    const double cutoff = reliefCutoffTexels(options);
+    if (cutoff > 0.0) {
+      featherSeams(matched, islands, std::sqrt(std::log(2.0) / 2.0) / CV_PI * cutoff, global);
+      resample(matched, HeightAtlas(global.clone(), valid.clone(), islands.labels.clone()));
+    }
     const cv::Vec2f range_after =
         maskedPercentiles(global, valid, options.percentile_low, options.percentile_high);
     summary.seams.step_after =
-        rmsStep(samples, offsets) / std::max(1e-12f, range_after[1] - range_after[0]);
+        rmsStep(matched, {}) / std::max(1e-12f, range_after[1] - range_after[0]);
   }
   HeightAtlas atlas = detail::finishAtlas(std::move(global), std::move(valid),
                                           std::move(islands.labels), options, summary.bake);
