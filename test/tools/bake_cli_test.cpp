@@ -90,6 +90,39 @@ TEST_F(BakeCli, BadInputExitsNonZeroWithOneLineReason) {
   }
 }
 
+TEST_F(BakeCli, ReliefOptionsPhysicalScaleAndMesh) {
+  // Default: the high-pass is reported with the long-wavelength share; --paper-exact has none.
+  const CliRun plain = bake(path("normal.png") + " -o " + path("h.tiff"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_NE(plain.output.find("relief high-pass at 64 texels"), std::string::npos) << plain.output;
+  const CliRun paper = bake(path("normal.png") + " --paper-exact -o " + path("p.tiff"));
+  ASSERT_EQ(paper.exit_code, 0) << paper.output;
+  EXPECT_NE(paper.output.find("no relief high-pass"), std::string::npos) << paper.output;
+  // Physical scale: heights in mm, the amplitude printed; needs a scale.
+  const CliRun physical =
+      bake(path("normal.png") + " --mm-per-texel 0.05 --physical -o " + path("mm.tiff"));
+  ASSERT_EQ(physical.exit_code, 0) << physical.output;
+  EXPECT_NE(physical.output.find("implied relief amplitude"), std::string::npos) << physical.output;
+  const CliRun no_scale = bake(path("normal.png") + " --physical -o " + path("x.tiff"));
+  EXPECT_EQ(no_scale.exit_code, 1) << no_scale.output;
+  EXPECT_NE(no_scale.output.find("mm_per_texel"), std::string::npos) << no_scale.output;
+  // With a mesh (a plate whose UVs cover the left half): texels off the chart are invalid
+  // (NaN) although the map has no alpha, and the scale comes from the mesh.
+  std::ofstream(path("plate.obj")) << "v 0 0 0\nv 0.0024 0 0\nv 0.0024 0.0032 0\nv 0 0.0032 0\n"
+                                      "vt 0 0\nvt 0.5 0\nvt 0.5 1\nvt 0 1\n"
+                                      "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  const CliRun meshed =
+      bake(path("normal.png") + " --mesh " + path("plate.obj") + " -o " + path("meshed.tiff"));
+  ASSERT_EQ(meshed.exit_code, 0) << meshed.output;
+  EXPECT_NE(meshed.output.find("mesh: 1 UV charts, 0.05 mm per texel"), std::string::npos)
+      << meshed.output;
+  const cv::Mat h = cv::imread(path("meshed.tiff"), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(h.type(), CV_32FC1);
+  const cv::Mat1b finite = h == h;
+  EXPECT_NEAR(cv::countNonZero(finite(cv::Rect(0, 0, 48, 64))), 48 * 64, 64);
+  EXPECT_EQ(cv::countNonZero(finite(cv::Rect(48, 0, 48, 64))), 0);
+}
+
 TEST_F(BakeCli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(bake(path("normal.png")).exit_code, 2) << "no -o";
   EXPECT_EQ(bake(path("normal.png") + " -o " + path("x.jpg")).exit_code, 2) << "bad extension";
