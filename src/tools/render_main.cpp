@@ -206,6 +206,7 @@ int run(int argc, char** argv) {
   if (args.flag("--sheet")) return renderSheet(args, model, mesh, output);
   std::shared_ptr<const norm2tex::HeightAtlas> atlas;
   double default_beta = 0.2;
+  bool physical_scale = false;  // the atlas holds mm: beta is a gain
   // --beta 0 is a textureless render: nothing to generate or bake.
   const bool textureless = args.has("--beta") && args.number("--beta", 0.0) == 0.0;
   if (textureless) {
@@ -229,6 +230,7 @@ int run(int argc, char** argv) {
     atlas = texture.atlas;
     // A mesh's own texture comes at physical scale (mm): its beta is a gain of 1.
     if (texture.beta_mm > 0.0) default_beta = texture.beta_mm;
+    physical_scale = texture.physical_scale;
     if (atlas) std::printf("texture: %s\n", texture.description.c_str());
   }
   const double beta = args.number("--beta", atlas ? default_beta : 0.0);
@@ -248,8 +250,13 @@ int run(int argc, char** argv) {
     norm2tex::writeImage(*depth_out, frame.depthMetres());
   if (const auto mask_out = args.value("--mask-out"))
     norm2tex::writeImage(*mask_out, frame.contact_mask);
-  char texture[64] = "textureless";
-  if (frame.textured) std::snprintf(texture, sizeof(texture), "textured, beta %.3g mm", beta);
+  char texture[96] = "textureless";
+  if (frame.textured) {
+    std::snprintf(
+        texture, sizeof(texture),
+        physical_scale ? "textured, beta %.3g (gain on heights in mm)" : "textured, beta %.3g mm",
+        beta);
+  }
   std::printf("%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
               cv::countNonZero(frame.contact_mask), texture, frame.raster.triangles_rasterized, ms);
   return 0;
