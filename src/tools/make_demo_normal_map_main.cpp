@@ -1,27 +1,64 @@
 // norm2tex_make_demo_normal_map: writes a UV-atlas-like normal map of known relief (waves,
 // bumps and ridges on irregular islands, alpha = island mask) to try the bake on, until the
 // procedural materials exist. The relief is analytic, so the bake can be checked by eye.
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <string>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cli_arguments.hpp"
-#include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/image_io.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 
 namespace {
 
 constexpr const char* kUsage =
     "usage: norm2tex_make_demo_normal_map -o OUT.png [--size PX] [--bits 8|16]\n"
-    "                                     [--convention opengl|directx] [--height-out H.tiff]\n";
+    "                                     [--convention opengl|directx] [--height-out H.tiff]\n"
+    "                                     [--one-island | --scan-like [--seed S]]\n"
+    "  --one-island: the same relief without alpha: every texel valid, one UV island.\n"
+    "  --scan-like: one island of random fine relief (wavelengths 3-40 texels) whose slopes\n"
+    "               carry a weak smooth bias (hundreds of texels), as photographed or scanned\n"
+    "               normal maps do; integrated, the bias becomes long-wavelength drift.\n";
+
+/// Smooth random field: white noise blurred with `sigma` texels, scaled to unit deviation.
+cv::Mat1f smoothNoise(cv::Size size, double sigma, cv::RNG& rng) {
+  cv::Mat1f noise(size);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), sigma, sigma, cv::BORDER_REFLECT);
+  cv::Scalar mean, deviation;
+  cv::meanStdDev(noise, mean, deviation);
+  return (noise - mean[0]) / std::max(deviation[0], 1e-12);
+}
+
+/// Fine relief (octaves of smooth noise, amplitude growing with wavelength) and its exact
+/// slopes, plus a smooth slope bias of 0.03 per texel, the integrator's drift source.
+norm2tex::AnalyticSurface scanLikeSurface(int size, std::uint64_t seed) {
+  const cv::Size extent(size, size);
+  cv::RNG rng(seed);
+  cv::Mat1f height(extent, 0.0f);
+  for (const double sigma : {0.6, 1.2, 2.5, 5.0})
+    height += 0.25 * sigma * smoothNoise(extent, sigma, rng);
+  norm2tex::AnalyticSurface surface;
+  surface.height = height;
+  cv::Sobel(height, surface.dx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT);
+  cv::Sobel(height, surface.dy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REFLECT);
+  const double bias_sigma = size / 8.0;
+  surface.dx += 0.03f * smoothNoise(extent, bias_sigma, rng);
+  surface.dy += 0.03f * smoothNoise(extent, bias_sigma, rng);
+  return surface;
+}
 
 int run(int argc, char** argv) {
   const norm2tex::cli::Arguments args(
-      argc, argv, {"-o", "--size", "--bits", "--convention", "--height-out"}, {"-h", "--help"});
+      argc, argv, {"-o", "--size", "--bits", "--convention", "--height-out", "--seed"},
+      {"-h", "--help", "--scan-like", "--one-island"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
     return 0;
@@ -33,6 +70,19 @@ int run(int argc, char** argv) {
   if (size < 64 || size > 8192) throw norm2tex::cli::UsageError("--size must be in [64, 8192]");
   if (bits != 8 && bits != 16) throw norm2tex::cli::UsageError("--bits must be 8 or 16");
   const auto convention = norm2tex::parseNormalConvention(args.value("--convention", "opengl"));
+
+  if (args.flag("--scan-like")) {
+    const norm2tex::AnalyticSurface surface =
+        scanLikeSurface(size, static_cast<std::uint64_t>(args.integer("--seed", 1)));
+    norm2tex::writeImage(output, norm2tex::encodeNormalMap(surface.dx, surface.dy, convention,
+                                                           bits == 8 ? CV_8U : CV_16U));
+    if (const auto height_out = args.value("--height-out")) {
+      norm2tex::writeImage(*height_out, surface.height);
+    }
+    std::printf("wrote %s (%dx%d, %d-bit RGB, %s, scan-like: one island, slope bias 0.03)\n",
+                output.c_str(), size, size, bits, norm2tex::toString(convention).c_str());
+    return 0;
+  }
 
   // Scales in fractions of the map so every size shows the same picture.
   const cv::Size extent(size, size);
@@ -51,14 +101,15 @@ int run(int argc, char** argv) {
   islands.convertTo(alpha, normals.depth(), bits == 8 ? 1.0 : 257.0);
   cv::Mat bgra;
   cv::merge(std::vector<cv::Mat>{normals, alpha}, bgra);
-  norm2tex::writeImage(output, bgra);
+  norm2tex::writeImage(output, args.flag("--one-island") ? normals : bgra);
   if (const auto height_out = args.value("--height-out")) {
     cv::Mat1f height = surface.height.clone();
     height.setTo(0.0f, islands == 0);
     norm2tex::writeImage(*height_out, height);
   }
-  std::printf("wrote %s (%dx%d, %d-bit RGBA, %s, 4 UV islands)\n", output.c_str(), size, size, bits,
-              norm2tex::toString(convention).c_str());
+  std::printf("wrote %s (%dx%d, %d-bit, %s, %s)\n", output.c_str(), size, size, bits,
+              norm2tex::toString(convention).c_str(),
+              args.flag("--one-island") ? "RGB, one UV island" : "RGBA, 4 UV islands");
   return 0;
 }
 

@@ -46,8 +46,9 @@ constexpr const char* kUsage =
     "  --material NAME: a procedural material (wood, fabric, rock, smooth, print3d) generated\n"
     "          for the mesh's UVs at its true millimetre scale (a mesh without UVs is unwrapped\n"
     "          first), with config/materials/NAME.yaml's parameters, range and beta.\n"
-    "  --beta: texture depth in mm (default: the material's, else 0.2 when a texture is given;\n"
-    "          0 = textureless).\n"
+    "  --beta: texture depth in mm (default: the material's; 1, a gain, for the mesh's own\n"
+    "          texture, baked in mm from the mesh's UV scale; else 0.2 mm; 0 = textureless,\n"
+    "          nothing is baked).\n"
     "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
     "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
     "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
@@ -86,13 +87,18 @@ Eigen::Isometry3d parsePose(const std::string& text, double press_mm) {
   return pose;
 }
 
-std::shared_ptr<const norm2tex::HeightAtlas> loadTexture(norm2tex::TextureSource source,
-                                                         const norm2tex::TexturedMesh& mesh) {
-  const norm2tex::ObjectTexture texture = norm2tex::loadTextureFile(source, mesh);
+norm2tex::ObjectTexture loadTextureWithWarning(norm2tex::TextureSource source,
+                                               const norm2tex::TexturedMesh& mesh) {
+  norm2tex::ObjectTexture texture = norm2tex::loadTextureFile(source, mesh);
   if (!texture.warning.empty()) {
     std::fprintf(stderr, "norm2tex_render: warning: %s\n", texture.warning.c_str());
   }
-  return texture.atlas;
+  return texture;
+}
+
+std::shared_ptr<const norm2tex::HeightAtlas> loadTexture(norm2tex::TextureSource source,
+                                                         const norm2tex::TexturedMesh& mesh) {
+  return loadTextureWithWarning(std::move(source), mesh).atlas;
 }
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -104,12 +110,12 @@ std::vector<std::string> splitList(const std::string& text) {
   return items;
 }
 
-std::shared_ptr<const norm2tex::HeightAtlas> loadAtlas(const norm2tex::cli::Arguments& args,
-                                                       const norm2tex::TexturedMesh& mesh) {
+norm2tex::ObjectTexture loadAtlas(const norm2tex::cli::Arguments& args,
+                                  const norm2tex::TexturedMesh& mesh) {
   norm2tex::TextureSource source;
   source.atlas = args.value("--atlas", "");
   if (source.atlas.empty()) source.normal_map = args.value("--normal-map", "");
-  return loadTexture(source, mesh);
+  return loadTextureWithWarning(source, mesh);
 }
 
 /// --sheet: rows = no texture, then each normal map; columns = press depths.
@@ -182,6 +188,11 @@ int run(int argc, char** argv) {
   if (args.has("--normal-map") && args.has("--atlas")) {
     throw norm2tex::cli::UsageError("give --normal-map or --atlas, not both");
   }
+  // Before any work or any file written: depth is float, the image 8-bit colour.
+  norm2tex::requireFormatHolds(output, CV_8UC3);
+  if (const auto depth_out = args.value("--depth-out")) {
+    norm2tex::requireFormatHolds(*depth_out, CV_32FC1);
+  }
 
   norm2tex::SensorModel model = args.has("--sensor")
                                     ? norm2tex::loadSensorModel(*args.value("--sensor"))
@@ -195,7 +206,12 @@ int run(int argc, char** argv) {
   if (args.flag("--sheet")) return renderSheet(args, model, mesh, output);
   std::shared_ptr<const norm2tex::HeightAtlas> atlas;
   double default_beta = 0.2;
-  if (const auto material = args.value("--material")) {
+  bool physical_scale = false;  // the atlas holds mm: beta is a gain
+  // --beta 0 is a textureless render: nothing to generate or bake.
+  const bool textureless = args.has("--beta") && args.number("--beta", 0.0) == 0.0;
+  if (textureless) {
+    // No texture to load.
+  } else if (const auto material = args.value("--material")) {
     // The material is generated for this mesh's own UV layout, so its scale in mm is right.
     const norm2tex::MaterialConfig config =
         norm2tex::loadMaterialConfig(norm2tex::cli::materialConfigPath(*material));
@@ -210,7 +226,12 @@ int run(int argc, char** argv) {
     default_beta = config.beta_mm;
   } else {
     const norm2tex::cli::QuietStderr quiet_decoders;
-    atlas = loadAtlas(args, *mesh);
+    const norm2tex::ObjectTexture texture = loadAtlas(args, *mesh);
+    atlas = texture.atlas;
+    // A mesh's own texture comes at physical scale (mm): its beta is a gain of 1.
+    if (texture.beta_mm > 0.0) default_beta = texture.beta_mm;
+    physical_scale = texture.physical_scale;
+    if (atlas) std::printf("texture: %s\n", texture.description.c_str());
   }
   const double beta = args.number("--beta", atlas ? default_beta : 0.0);
 
@@ -229,8 +250,13 @@ int run(int argc, char** argv) {
     norm2tex::writeImage(*depth_out, frame.depthMetres());
   if (const auto mask_out = args.value("--mask-out"))
     norm2tex::writeImage(*mask_out, frame.contact_mask);
-  char texture[64] = "textureless";
-  if (frame.textured) std::snprintf(texture, sizeof(texture), "textured, beta %.3g mm", beta);
+  char texture[96] = "textureless";
+  if (frame.textured) {
+    std::snprintf(
+        texture, sizeof(texture),
+        physical_scale ? "textured, beta %.3g (gain on heights in mm)" : "textured, beta %.3g mm",
+        beta);
+  }
   std::printf("%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
               cv::countNonZero(frame.contact_mask), texture, frame.raster.triangles_rasterized, ms);
   return 0;

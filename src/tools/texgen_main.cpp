@@ -18,12 +18,12 @@
 #include "cli_arguments.hpp"
 #include "contact_sheet.hpp"
 #include "norm2tex/common/error.hpp"
-#include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/common/image_io.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/material_texture.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
 #include "package_paths.hpp"
 #include "quiet_stderr.hpp"
 
@@ -131,6 +131,9 @@ std::vector<cv::Mat3b> galleryRow(const norm2tex::MaterialConfig& config, std::u
       norm2tex::renderMaterialTexture(*material, size, config.mm_per_texel, CV_16U);
   norm2tex::BakeOptions options;
   options.range = config.range;
+  // As bakeMaterialAtlas: a designed height has no integration drift to remove.
+  options.relief_cutoff_mm = 0.0;
+  options.relief_cutoff_texels = 0.0;
   const auto atlas = std::make_shared<const norm2tex::HeightAtlas>(norm2tex::bakeHeightAtlas(
       norm2tex::NormalMap::fromImage(texture.normal_map, options.normal_map), options));
   // A face one texture wide, so UV [0, 1] spans it once and the gel sees the texture's middle.

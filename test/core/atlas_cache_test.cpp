@@ -1,3 +1,4 @@
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -6,9 +7,9 @@
 #include <unistd.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "norm2tex/common/error.hpp"
 #include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/texture/atlas_cache.hpp"
-#include "norm2tex/common/error.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 #include "test_helpers.hpp"
 
@@ -35,6 +36,31 @@ class AtlasCacheTest : public testing::Test {
   test::ScratchDirectory dir_;
   std::string normal_map_path_;
 };
+
+TEST_F(AtlasCacheTest, MeshBakesAreCachedUnderTheMeshToo) {
+  // A 20 x 15 mm plate whose UVs cover the texture once.
+  const auto plate = [](float width_m) {
+    return TexturedMesh({{0, 0, 0}, {width_m, 0, 0}, {width_m, 0.015f, 0}, {0, 0.015f, 0}},
+                        {{0, 1, 2}, {0, 2, 3}}, {{0, 0}, {1, 0}, {1, 1}, {0, 1}});
+  };
+  const TexturedMesh mesh = plate(0.02f), wider = plate(0.04f);
+  const AtlasCache cache(dir_.path("cache"));
+  BakeOptions options;
+  options.physical_scale = true;  // needs the mesh's mm per texel
+  const AtlasCache::Result first = cache.loadOrBake(normal_map_path_, "", options, {}, &mesh);
+  EXPECT_FALSE(first.was_cached);
+  EXPECT_NEAR(first.mesh_report.mm_per_texel, std::sqrt(20.0 / 64 * 15.0 / 48), 1e-3);
+  const AtlasCache::Result second = cache.loadOrBake(normal_map_path_, "", options, {}, &mesh);
+  EXPECT_TRUE(second.was_cached);
+  EXPECT_EQ(cv::norm(first.atlas.heights(), second.atlas.heights(), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(first.atlas.islandLabels() != second.atlas.islandLabels()), 0);
+  // Another mesh (other scale: other heights in mm) or none: other entries.
+  EXPECT_NE(cache.key(normal_map_path_, "", options, &mesh),
+            cache.key(normal_map_path_, "", options, &wider));
+  EXPECT_NE(cache.key(normal_map_path_, "", options, &mesh),
+            cache.key(normal_map_path_, "", options));
+  EXPECT_FALSE(cache.loadOrBake(normal_map_path_, "", options, {}, &wider).was_cached);
+}
 
 TEST_F(AtlasCacheTest, SecondLoadComesFromTheCacheBitForBit) {
   const AtlasCache cache(dir_.path("cache"));

@@ -4,8 +4,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/texture/frankot_chellappa.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
@@ -22,6 +23,14 @@ struct Case {
   double min_correlation;
 };
 
+/// The paper's defaults without the relief high-pass: what integration against the analytic
+/// truth measures (the truths here have relief at wavelengths near the default cutoff).
+BakeOptions withoutReliefFilter() {
+  BakeOptions options;
+  options.relief_cutoff_texels = 0.0;
+  return options;
+}
+
 AnalyticSurface mixedSurface(cv::Size size) {
   AnalyticSurface s = makeWaves(size, {{2.0, 45.0, 0.3, 0.0}, {0.8, 19.0, 2.1, 1.0}});
   s += makeBumps(size, {{{70, 60}, 10.0, 8.0}, {{190, 170}, 14.0, -6.0}});
@@ -33,7 +42,7 @@ void expectIslandsMatchTruth(const AnalyticSurface& truth, const cv::Mat1b& mask
                              double min_correlation, const std::string& what) {
   const NormalMap map = test::quantisedNormalMap(truth, mask, depth);
   BakeReport report;
-  const HeightAtlas atlas = bakeHeightAtlas(map, {}, {}, &report);
+  const HeightAtlas atlas = bakeHeightAtlas(map, withoutReliefFilter(), {}, &report);
   const UvIslands islands = findUvIslands(mask);
   ASSERT_EQ(report.island_count, static_cast<int>(islands.islands.size())) << what;
   double worst = 1.0;
@@ -130,8 +139,10 @@ TEST(Bake, MeanSlopeRemovalIsAnOption) {
   const cv::Mat1b all(size, 255);
   const NormalMap map = test::quantisedNormalMap(truth, all, CV_16U);
   const AnalyticSurface bump_only = makeBumps(size, {{{64, 48}, 8, 3}});
-  EXPECT_GT(test::correlation(bakeHeightAtlas(map).heights(), bump_only.height, all), 0.99);
-  BakeOptions keep_tilt;
+  EXPECT_GT(test::correlation(bakeHeightAtlas(map, withoutReliefFilter()).heights(),
+                              bump_only.height, all),
+            0.99);
+  BakeOptions keep_tilt = withoutReliefFilter();
   keep_tilt.remove_mean_slope = false;
   const cv::Mat1f tilted = bakeHeightAtlas(map, keep_tilt).heights();
   EXPECT_GT(test::correlation(tilted, truth.height, all), 0.995);
@@ -153,17 +164,93 @@ TEST(Bake, ConventionSettingMattersAndMatches) {
   const AnalyticSurface truth = mixedSurface(size);
   const cv::Mat1b all(size, 255);
   const HeightAtlas gl =
-      bakeHeightAtlas(test::quantisedNormalMap(truth, all, CV_16U, NormalConvention::kOpenGL));
+      bakeHeightAtlas(test::quantisedNormalMap(truth, all, CV_16U, NormalConvention::kOpenGL),
+                      withoutReliefFilter());
   const cv::Mat dx_image = encodeNormalMap(truth.dx, truth.dy, NormalConvention::kDirectX, CV_16U);
-  BakeOptions dx_options;
+  BakeOptions dx_options = withoutReliefFilter();
   dx_options.normal_map.convention = NormalConvention::kDirectX;
   const HeightAtlas dx =
       bakeHeightAtlas(NormalMap::fromImage(dx_image, dx_options.normal_map), dx_options);
-  const HeightAtlas wrong = bakeHeightAtlas(NormalMap::fromImage(dx_image));
+  const HeightAtlas wrong = bakeHeightAtlas(NormalMap::fromImage(dx_image), withoutReliefFilter());
   EXPECT_GT(test::correlation(gl.heights(), dx.heights(), all), 0.9999);
   const cv::Mat1f expected = test::withoutMeanSlope(truth, all);
   EXPECT_GT(test::correlation(gl.heights(), expected, all), 0.99);
   EXPECT_LT(test::correlation(wrong.heights(), expected, all), 0.9);
+}
+
+/// Amplitude of the known zero-mean pattern `relief` in `height`, by least squares over `mask`,
+/// relative to the height's range (max - min over the mask).
+double reliefAmplitudeRelativeToRange(const cv::Mat1f& height, const cv::Mat1f& relief,
+                                      const cv::Mat1b& mask) {
+  const double mean = cv::mean(height, mask)[0];
+  double dot = 0.0, norm = 0.0;
+  for (int r = 0; r < height.rows; ++r) {
+    for (int c = 0; c < height.cols; ++c) {
+      if (!mask(r, c)) continue;
+      dot += (height(r, c) - mean) * relief(r, c);
+      norm += relief(r, c) * relief(r, c);
+    }
+  }
+  double low, high;
+  cv::minMaxLoc(height, &low, &high, nullptr, nullptr, mask);
+  return dot / norm / (high - low);
+}
+
+TEST(Bake, FineReliefSurvivesLargeDrift) {
+  // A real normal map's integral: fine relief (8-texel bumps) under drift 30x its amplitude
+  // at wavelengths of hundreds of texels.
+  const cv::Size size(384, 320);
+  const AnalyticSurface fine = makeWaves(size, {{0.5, 8.0, 0.4, 0.0}, {0.5, 11.0, 2.0, 0.7}});
+  // (AnalyticSurface copies share their matrices: build the sum from a fresh surface.)
+  AnalyticSurface drifting = makeWaves(size, {{15.0, 700.0, 0.3, 1.0}, {10.0, 450.0, 1.9, 0.2}});
+  drifting += fine;
+  const cv::Mat1b all(size, 255);
+  const cv::Mat1f pattern = fine.height - cv::mean(fine.height)[0];
+  const auto amplitude = [&](const AnalyticSurface& surface, const BakeOptions& options) {
+    const HeightAtlas atlas =
+        bakeHeightAtlas(test::quantisedNormalMap(surface, all, CV_16U), options);
+    return reliefAmplitudeRelativeToRange(atlas.heights(), pattern, all);
+  };
+  const double alone = amplitude(fine, {});
+  const double with_drift = amplitude(drifting, {});
+  EXPECT_GE(with_drift, 0.8 * alone) << "the default bake keeps the relief";
+  const double paper = amplitude(drifting, paperExactBakeOptions());
+  EXPECT_LT(paper, 0.2 * alone) << "the paper's bake spends the range on the drift";
+  testing::Test::RecordProperty("relief_kept_default", std::to_string(with_drift / alone));
+  testing::Test::RecordProperty("relief_kept_paper", std::to_string(paper / alone));
+
+  // The same on a ring-shaped island (the low-pass normalised by the island's own weights).
+  cv::Mat1b ring(size, uchar(0));
+  cv::circle(ring, {190, 160}, 150, 255, cv::FILLED);
+  cv::circle(ring, {190, 160}, 50, 0, cv::FILLED);
+  const auto island_amplitude = [&](const AnalyticSurface& surface) {
+    const HeightAtlas atlas = bakeHeightAtlas(test::quantisedNormalMap(surface, ring, CV_16U));
+    return reliefAmplitudeRelativeToRange(atlas.heights(), pattern, ring);
+  };
+  const double ring_kept = island_amplitude(drifting) / island_amplitude(fine);
+  EXPECT_GE(ring_kept, 0.8);
+  testing::Test::RecordProperty("relief_kept_ring", std::to_string(ring_kept));
+}
+
+TEST(Bake, PhysicalScaleGivesMillimetresAndReportsTheAmplitude) {
+  // Slopes are dh/dx: a wave of amplitude 2 texels at 0.05 mm per texel is 0.1 mm high.
+  const cv::Size size(128, 128);
+  const AnalyticSurface s = makeWaves(size, {{2.0, 16.0, 0.0, 0.0}});
+  const cv::Mat1b all(size, 255);
+  BakeOptions options;
+  options.mm_per_texel = 0.05;
+  options.physical_scale = true;
+  BakeReport report;
+  const HeightAtlas atlas =
+      bakeHeightAtlas(test::quantisedNormalMap(s, all, CV_16U), options, {}, &report);
+  double low, high;
+  cv::minMaxLoc(atlas.heights(), &low, &high);
+  EXPECT_NEAR(high - low, 0.2, 0.01) << "peak to valley, mm";
+  EXPECT_NEAR(report.relief_amplitude_mm, 0.2, 0.01);
+  EXPECT_NEAR(report.relief_cutoff_texels, 2.0 / 0.05, 1e-9) << "2 mm cutoff in texels";
+  BakeOptions no_scale;
+  no_scale.physical_scale = true;
+  test::expectError([&] { validate(no_scale); }, {"physical_scale", "mm_per_texel"});
 }
 
 TEST(Bake, ReportsProgressUpToOne) {

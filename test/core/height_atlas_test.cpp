@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -80,6 +81,65 @@ TEST(HeightAtlas, FarFromEveryIslandIsNotValid) {
   EXPECT_TRUE(ok);
   EXPECT_FLOAT_EQ(atlas.sample(std::nan(""), 0.5, &ok), 0.0f);
   EXPECT_FALSE(ok);
+}
+
+TEST(HeightAtlas, NonFiniteTexelsAreInvalidNeverHeights) {
+  cv::Mat1f heights(3, 4, 0.25f);
+  heights(1, 1) = std::numeric_limits<float>::quiet_NaN();
+  heights(1, 2) = std::numeric_limits<float>::infinity();
+  heights(0, 3) = -std::numeric_limits<float>::infinity();
+  const HeightAtlas atlas(heights, cv::Mat1b(3, 4, 255), UvWrap::kClamp);
+  EXPECT_EQ(cv::countNonZero(atlas.valid()), 12 - 3);
+  EXPECT_EQ(atlas.valid()(1, 1), 0);
+  EXPECT_EQ(atlas.valid()(1, 2), 0);
+  EXPECT_TRUE(cv::checkRange(atlas.heights())) << "no NaN or inf left";
+  // Every look-up, also right on the bad texels, is a finite height of the good ones.
+  for (double u = 0.0; u <= 1.0; u += 0.05) {
+    for (double v = 0.0; v <= 1.0; v += 0.05) {
+      bool valid = false;
+      const float h = atlas.sample(u, v, &valid);
+      ASSERT_TRUE(std::isfinite(h));
+      if (valid) {
+        EXPECT_FLOAT_EQ(h, 0.25f) << u << "," << v;
+      }
+    }
+  }
+}
+
+TEST(HeightAtlas, OwnsItsDataALaterWriteByTheCallerChangesNothing) {
+  cv::Mat1f heights(4, 4, 1.0f);
+  cv::Mat1b valid(4, 4, 255);
+  valid(0, 0) = 0;
+  const HeightAtlas atlas(heights, valid);
+  heights.setTo(7.0f);
+  valid.setTo(0);
+  EXPECT_FLOAT_EQ(atlas.sample(0.5, 0.5), 1.0f);
+  EXPECT_EQ(cv::countNonZero(atlas.valid()), 15);
+  EXPECT_FLOAT_EQ(heights(0, 0), 7.0f) << "the caller's matrix is not written by the atlas";
+  cv::Mat1f roi_source(8, 8, 2.0f);
+  const HeightAtlas from_roi(roi_source(cv::Rect(2, 2, 4, 4)), cv::Mat1b(4, 4, 255));
+  roi_source.setTo(0.0f);
+  EXPECT_FLOAT_EQ(from_roi.sample(0.5, 0.5), 2.0f);
+}
+
+TEST(HeightAtlas, GivenIslandLabelsKeepTouchingIslandsApart) {
+  // Two charts side by side with no gap: as one 4-connected region they would blend at the
+  // seam; with the bake's (or the mesh's) labels they do not.
+  cv::Mat1f heights(2, 4);
+  heights << 0.0f, 0.0f, 8.0f, 8.0f, 0.0f, 0.0f, 8.0f, 8.0f;
+  cv::Mat1i labels(2, 4);
+  labels << 1, 1, 2, 2, 1, 1, 2, 2;
+  const HeightAtlas atlas(heights, cv::Mat1b(2, 4, 255), labels, UvWrap::kClamp);
+  EXPECT_EQ(atlas.islandCount(), 2);
+  // u = 0.45 lies between texel columns 1 (island 1) and 2 (island 2), nearer column 1.
+  EXPECT_FLOAT_EQ(atlas.sample(0.45, 0.5), 0.0f);
+  EXPECT_FLOAT_EQ(atlas.sample(0.55, 0.5), 8.0f);
+  const HeightAtlas merged(heights, cv::Mat1b(2, 4, 255), UvWrap::kClamp);
+  EXPECT_EQ(merged.islandCount(), 1);
+  EXPECT_GT(merged.sample(0.45, 0.5), 0.0f) << "one region blends across the seam";
+  cv::Mat1i wrong = labels.clone();
+  wrong(0, 0) = 0;  // a valid texel without an island
+  EXPECT_THROW(HeightAtlas(heights, cv::Mat1b(2, 4, 255), wrong), Error);
 }
 
 TEST(HeightAtlas, RejectsEmptyOrMismatchedInput) {

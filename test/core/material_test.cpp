@@ -16,11 +16,11 @@
 #include <opencv2/core.hpp>
 
 #include "norm2tex/common/error.hpp"
-#include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/materials/procedural_material.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 #include "norm2tex/texture/normal_map.hpp"
-#include "norm2tex/materials/procedural_material.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {
@@ -296,15 +296,18 @@ TEST(Material, NormalMapsDecodeToUnitNormals) {
   }
 }
 
-/// Height -> 16-bit normal map -> bakeHeightAtlas (paper defaults, mean slope removed):
-/// correlation of H_global with the height minus its mean-slope plane.
+/// Height -> 16-bit normal map -> bakeHeightAtlas (paper defaults, mean slope removed, no
+/// relief high-pass, as bakeMaterialAtlas bakes materials): correlation of H_global with the
+/// height minus its mean-slope plane.
 double roundTripCorrelation(const ProceduralMaterial& material, double mm_per_texel) {
   const cv::Size size(256, 256);
   const cv::Mat1b all(size, 255);
   const cv::Mat1f height = material.renderHeightMm(size, mm_per_texel) / mm_per_texel;
   const NormalMap map =
       NormalMap::fromImage(encodeNormalMapFromHeight(height, NormalConvention::kOpenGL, CV_16U));
-  const HeightAtlas atlas = bakeHeightAtlas(map);
+  BakeOptions options;
+  options.relief_cutoff_texels = 0.0;
+  const HeightAtlas atlas = bakeHeightAtlas(map, options);
   return test::correlation(atlas.heights(), test::withoutMeanSlope(surfaceOf(height), all), all);
 }
 
@@ -401,7 +404,20 @@ TEST(Material, TimingsOf2048Textures) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("[ timing     ] %-8s renderHeightMm 2048 x 2048: %.3f s\n", name.c_str(), seconds);
     testing::Test::RecordProperty("seconds_2048_" + name, std::to_string(seconds));
+    ASSERT_EQ(height.size(), cv::Size(2048, 2048));
     EXPECT_TRUE(cv::checkRange(height));
+    // What is timed must be right: the fast grid path equals the per-point height at texel
+    // centres ((c + 0.5), (r + 0.5)) * 0.05 mm, everywhere including the far corner, and the
+    // texture has relief.
+    cv::RNG rng(3);
+    double worst = 0.0;
+    for (int i = 0; i < 400; ++i) {
+      const int r = i == 0 ? 2047 : rng.uniform(0, 2048), c = i == 0 ? 2047 : rng.uniform(0, 2048);
+      const double expected = material->heightMm((c + 0.5) * 0.05, (r + 0.5) * 0.05);
+      worst = std::max(worst, std::fabs(height(r, c) - expected));
+    }
+    EXPECT_LT(worst, 1e-5) << name << ": grid and per-point heights differ (mm)";
+    EXPECT_GT(test::maskedStdDev(height, cv::Mat1b(height.size(), 255)), 1e-5) << name;  // mm
   }
 }
 

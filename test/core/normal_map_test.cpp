@@ -1,5 +1,6 @@
 #include <cmath>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -173,10 +174,30 @@ TEST(NormalMapErrors, FileProblemsNameTheFile) {
   std::ofstream(dir.path("empty.png")).close();
   expectError(dir.path("empty.png"), "empty file");
   std::ofstream(dir.path("corrupt.png")) << "\x89PNG\r\n\x1a\nthis is not really a png";
-  expectError(dir.path("corrupt.png"), "cannot be decoded");
+  expectError(dir.path("corrupt.png"), "corrupt");
   expectError(dir.root(), "directory");
   cv::imwrite(dir.path("gray.png"), cv::Mat(4, 4, CV_8UC1, cv::Scalar(7)));
   expectError(dir.path("gray.png"), "grayscale");
+}
+
+TEST(NormalMapErrors, TruncatedFilesAreRefusedNotDecodedAsGrey) {
+  // libjpeg decodes a truncated JPEG with grey rows (a constant tilt); every cut must fail,
+  // whatever the format, and the intact file must load.
+  test::ScratchDirectory dir;
+  const cv::Size size(64, 48);
+  const AnalyticSurface s = makeWaves(size, {{2.0, 20.0, 0.4, 0.0}});
+  const cv::Mat image = encodeNormalMap(s.dx, s.dy, NormalConvention::kOpenGL, CV_8U);
+  for (const std::string name : {"map.png", "map.jpg", "map.tif"}) {
+    ASSERT_TRUE(cv::imwrite(dir.path(name), image));
+    std::ifstream file(dir.path(name), std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    EXPECT_NO_THROW(NormalMap::load(dir.path(name))) << name;
+    for (const size_t cut : {size_t(200), bytes.size() / 2, bytes.size() - 40}) {
+      const std::string truncated = dir.path("cut_" + std::to_string(cut) + "_" + name);
+      std::ofstream(truncated, std::ios::binary) << bytes.substr(0, cut);
+      test::expectError([&] { NormalMap::load(truncated); }, {truncated, "corrupt"});
+    }
+  }
 }
 
 TEST(NormalMapErrors, OptionsOutOfRangeAreRejected) {

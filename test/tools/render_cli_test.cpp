@@ -1,6 +1,7 @@
 // Runs the real norm2tex_render executable: outputs, the sheet, exit codes and messages.
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -61,9 +62,58 @@ TEST_F(RenderCli, SheetHasOneRowPerTextureAndOneColumnPerPress) {
              path("ridges.png") + "," + path("ridges.png") + " -o " + path("sheet.png"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("3 x 2"), std::string::npos) << run.output;
-  const cv::Mat sheet = cv::imread(path("sheet.png"));
-  EXPECT_GT(sheet.cols, 2 * 240);
-  EXPECT_GT(sheet.rows, 3 * 320);
+  const cv::Mat3b sheet = cv::imread(path("sheet.png"));
+  // Layout of contact_sheet.cpp: 28 px of column labels, 150 px of row labels, 4 px gaps.
+  ASSERT_EQ(sheet.rows, 28 + 3 * (320 + 4));
+  ASSERT_EQ(sheet.cols, 150 + 2 * (240 + 4));
+  const auto tile = [&](int row, int column) {
+    return cv::Mat3b(sheet(cv::Rect(150 + column * 244, 28 + row * 324, 240, 320)));
+  };
+  const auto difference = [](const cv::Mat3b& a, const cv::Mat3b& b) {
+    return cv::norm(a, b, cv::NORM_L1) / (a.total() * 3.0);
+  };
+  for (int column = 0; column < 2; ++column) {
+    // Row 0 textureless, rows 1 and 2 the same normal map: the texture shows and is the same.
+    EXPECT_GT(difference(tile(0, column), tile(1, column)), 0.05) << "press " << column;
+    EXPECT_EQ(difference(tile(1, column), tile(2, column)), 0.0) << "press " << column;
+  }
+  EXPECT_GT(difference(tile(0, 0), tile(0, 1)), 0.1) << "a deeper press is another image";
+}
+
+TEST_F(RenderCli, FloatDepthToAnEightBitFormatIsRefusedBeforeAnyOutput) {
+  const CliRun run =
+      render(std::string(kBall) + " -o " + path("frame.png") + " --depth-out " + path("depth.png"));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("depth.png"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(".tiff"), std::string::npos) << "names the format to use";
+  EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  EXPECT_FALSE(fs::exists(path("frame.png")));
+  EXPECT_FALSE(fs::exists(path("depth.png")));
+}
+
+TEST_F(RenderCli, AtlasNaNTexelsAreInvalidAndInfiniteOnesAnError) {
+  // Left half NaN (invalid, as norm2tex_bake writes), right half a height of 1.
+  cv::Mat1f atlas(64, 64, 1.0f);
+  atlas(cv::Rect(0, 0, 32, 64)).setTo(std::numeric_limits<float>::quiet_NaN());
+  cv::imwrite(path("nan.tiff"), atlas);
+  const CliRun run =
+      render(std::string(kBall) + " --atlas " + path("nan.tiff") + " --beta 0.2 -o " +
+             path("frame.png") + " --depth-out " + path("depth.tiff"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const cv::Mat depth = cv::imread(path("depth.tiff"), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(depth.type(), CV_32FC1);
+  EXPECT_TRUE(cv::checkRange(depth)) << "no NaN depth";
+  double max_depth = 0;
+  cv::minMaxLoc(depth, nullptr, &max_depth);
+  EXPECT_LT(max_depth, 1.0e-3 + 0.2e-3 + 0.15e-3) << "press + beta at most, never a slab";
+
+  atlas(cv::Rect(40, 10, 3, 3)).setTo(std::numeric_limits<float>::infinity());
+  cv::imwrite(path("inf.tiff"), atlas);
+  const CliRun bad =
+      render(std::string(kBall) + " --atlas " + path("inf.tiff") + " -o " + path("bad.png"));
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("infinite"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(path("bad.png")));
 }
 
 TEST_F(RenderCli, BadInputIsAOneLineErrorOrUsage) {

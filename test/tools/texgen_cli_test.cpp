@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cli_runner.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
@@ -61,9 +62,45 @@ TEST_F(TexgenCli, WritesAlbedoHeightAndEightBit) {
       texgen("--material rock --size 64 --bits 8 --param grain_size_mm=1.5 -o " + path("n.png") +
              " --albedo " + path("a.png") + " --height-out " + path("h.tiff"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_EQ(cv::imread(path("n.png"), cv::IMREAD_UNCHANGED).type(), CV_8UC4);
-  EXPECT_EQ(cv::imread(path("a.png"), cv::IMREAD_UNCHANGED).type(), CV_8UC3);
-  EXPECT_EQ(cv::imread(path("h.tiff"), cv::IMREAD_UNCHANGED).type(), CV_32FC1);
+  const cv::Mat normal = cv::imread(path("n.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat albedo = cv::imread(path("a.png"), cv::IMREAD_UNCHANGED);
+  const cv::Mat height = cv::imread(path("h.tiff"), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(normal.type(), CV_8UC4);
+  ASSERT_EQ(albedo.type(), CV_8UC3);
+  ASSERT_EQ(height.type(), CV_32FC1);
+  ASSERT_EQ(normal.size(), cv::Size(64, 64));
+  EXPECT_EQ(albedo.size(), normal.size());
+  EXPECT_EQ(height.size(), normal.size());
+  // The three files describe one surface: the normal map is the height's slope. Decode the
+  // 8-bit normals and compare with central differences of the height (mm over mm per texel).
+  double mm_per_texel = 0.0;
+  {
+    const auto at = run.output.find(" mm per texel");
+    ASSERT_NE(at, std::string::npos) << run.output;
+    const auto start = run.output.rfind(' ', at - 1);
+    mm_per_texel = std::stod(run.output.substr(start + 1, at - start - 1));
+  }
+  ASSERT_GT(mm_per_texel, 0.0);
+  cv::Mat1f predicted_x(62, 62), decoded_x(62, 62);
+  for (int r = 1; r < 63; ++r) {
+    for (int c = 1; c < 63; ++c) {
+      const cv::Vec4b n = normal.at<cv::Vec4b>(r, c);  // B, G, R, A
+      const double nx = 2.0 * n[2] / 255.0 - 1.0, nz = 2.0 * n[0] / 255.0 - 1.0;
+      decoded_x(r - 1, c - 1) = static_cast<float>(-nx / nz);
+      predicted_x(r - 1, c - 1) = static_cast<float>(
+          (height.at<float>(r, c + 1) - height.at<float>(r, c - 1)) / (2.0 * mm_per_texel));
+    }
+  }
+  cv::Mat correlation;
+  cv::matchTemplate(decoded_x, predicted_x, correlation, cv::TM_CCOEFF_NORMED);
+  EXPECT_GT(correlation.at<float>(0, 0), 0.9) << "normal map and height disagree";
+  // Every texel is valid (alpha 255) and the albedo is not one flat colour.
+  std::vector<cv::Mat> channels;
+  cv::split(normal, channels);
+  EXPECT_EQ(cv::countNonZero(channels[3] != 255), 0);
+  cv::Scalar mean, deviation;
+  cv::meanStdDev(albedo, mean, deviation);
+  EXPECT_GT(deviation[0] + deviation[1] + deviation[2], 3.0);
 }
 
 TEST_F(TexgenCli, MeshWithoutUvsIsUnwrappedAndWrittenWithItsNormalMap) {
@@ -101,9 +138,25 @@ TEST_F(TexgenCli, VariantsAreFilesPlusAManifest) {
 TEST_F(TexgenCli, GalleryHasARowPerMaterial) {
   const CliRun run = texgen("--gallery -o " + path("gallery.png"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const cv::Mat gallery = cv::imread(path("gallery.png"));
-  EXPECT_GT(gallery.rows, 5 * 320);
-  EXPECT_GT(gallery.cols, 4 * 240);
+  const cv::Mat3b gallery = cv::imread(path("gallery.png"));
+  // Layout of contact_sheet.cpp: 28 px of column labels, 150 px of row labels, 4 px gaps;
+  // one row per material (5), columns albedo, normal map, no texture, texture.
+  ASSERT_EQ(gallery.rows, 28 + 5 * (320 + 4));
+  ASSERT_EQ(gallery.cols, 150 + 4 * (240 + 4));
+  const auto tile = [&](int row, int column) {
+    return cv::Mat3b(gallery(cv::Rect(150 + column * 244, 28 + row * 324, 240, 320)));
+  };
+  for (int row = 0; row < 5; ++row) {
+    // The material's texture changes the pressed image (column 3 against column 2; same
+    // noise seed, so without texture they would be equal; "smooth" changes it least)...
+    EXPECT_GT(cv::norm(tile(row, 2), tile(row, 3), cv::NORM_L1) / (240.0 * 320.0), 0.1)
+        << "row " << row;
+    // ...and each row is another material.
+    for (int other = 0; other < row; ++other) {
+      EXPECT_GT(cv::norm(tile(row, 1), tile(other, 1), cv::NORM_L1) / (240.0 * 320.0), 1.0)
+          << "rows " << other << " and " << row << " show the same normal map";
+    }
+  }
 }
 
 TEST_F(TexgenCli, BadInputListsTheValidChoices) {

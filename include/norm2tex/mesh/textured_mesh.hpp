@@ -52,6 +52,14 @@ class TexturedMesh {
   /// OBJ norm, else OBJ map_Bump / bump), resolved against the mesh file's directory; from the
   /// first mesh whose material has one. Empty when there is none or it is embedded in the file.
   const std::string& normalTexturePath() const { return normal_texture_path_; }
+  /// The normal texture's reference as the file writes it ("textures/n.png", or "*0" for the
+  /// first texture embedded in a GLB); empty when the material has none. For messages.
+  const std::string& normalTextureReference() const { return normal_texture_reference_; }
+  /// The bytes of an embedded normal texture (a PNG or JPEG file inside a GLB or glTF data
+  /// URI), empty when the texture is a file of its own or there is none.
+  const std::vector<unsigned char>& embeddedNormalTexture() const {
+    return embedded_normal_texture_;
+  }
   /// Axis-aligned bounds in the object frame, metres.
   const Eigen::AlignedBox3f& bounds() const { return bounds_; }
 
@@ -76,6 +84,8 @@ class TexturedMesh {
   std::vector<Eigen::Vector3i> triangles_;
   std::vector<Eigen::Vector2f> uvs_;
   std::string normal_texture_path_;
+  std::string normal_texture_reference_;
+  std::vector<unsigned char> embedded_normal_texture_;
   std::string source_path_;
   Eigen::AlignedBox3f bounds_;
   std::vector<BvhNode> bvh_nodes_;

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 namespace norm2tex {
@@ -20,6 +22,13 @@ struct ContactRaster {
   cv::Rect covered_box;
   /// Triangles that reached the rasterizer after culling (for diagnostics and benchmarks).
   int triangles_rasterized = 0;
+  /// Pixel centres found inside a triangle, before the depth test, summed over triangles: equal
+  /// to the covered pixel count when every pixel lies under exactly one triangle (a watertight
+  /// surface seen from one side). For diagnostics and tests.
+  long pixel_hits = 0;
+  /// Scratch of the rasterizer (culled triangle indices), kept here so that one rasterizer can
+  /// serve several threads, each with its own ContactRaster, without reallocating per frame.
+  std::vector<int> candidates;
 };
 
 }  // namespace norm2tex

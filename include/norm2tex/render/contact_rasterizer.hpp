@@ -2,9 +2,9 @@
 
 #include <Eigen/Geometry>
 
+#include "norm2tex/mesh/textured_mesh.hpp"
 #include "norm2tex/render/contact_raster.hpp"
 #include "norm2tex/render/sensor_model.hpp"
-#include "norm2tex/mesh/textured_mesh.hpp"
 
 namespace norm2tex {
 
@@ -14,7 +14,14 @@ namespace norm2tex {
 /// Only triangles that the mesh's BVH places near the gel (inside the gel's footprint, at most
 /// `reach_mm` above the gel surface) are rasterized, so large meshes stay fast. Pixel centres
 /// follow SensorModel::pixelToGelMm; a pixel is covered when its centre lies inside the
-/// projected triangle (top-left fill rule, so shared edges are drawn once).
+/// projected triangle. Watertight: corners are snapped to 1/256 pixel and the edge functions
+/// evaluated exactly in 64-bit integers, with the top-left rule for centres exactly on an edge,
+/// so a pixel under an edge shared by two triangles is drawn by exactly one of them (no holes,
+/// no double cover). Corners further than 2^22 pixels from the image (a triangle hundreds of
+/// metres across) fall back to floating point.
+///
+/// rasterize() is const and thread-safe: several threads may share one rasterizer, each with
+/// its own ContactRaster.
 class ContactRasterizer {
  public:
   explicit ContactRasterizer(const SensorModel& model);
@@ -33,7 +40,6 @@ class ContactRasterizer {
  private:
   SensorModel model_;
   cv::Mat1f gel_surface_mm_;
-  mutable std::vector<int> candidates_;  // reused between frames to avoid reallocation
 };
 
 }  // namespace norm2tex

@@ -18,19 +18,29 @@ struct TextureSource {
   std::uint64_t seed = 0;       ///< material seed
   std::string normal_map;       ///< PNG/JPEG/TIFF normal map, baked through the AtlasCache
   NormalConvention convention = NormalConvention::kOpenGL;
-  std::string atlas;  ///< a baked H_global: single-channel 32-bit float TIFF
+  /// A baked H_global: single-channel 32-bit float TIFF; NaN texels are invalid (what
+  /// norm2tex_bake writes outside every island), infinite ones an error.
+  std::string atlas;
 };
 
 /// H_global for the TextureOverlay, and what it came from.
 struct ObjectTexture {
   std::shared_ptr<const HeightAtlas> atlas;  ///< null: no texture
-  double beta_mm = 0.0;                      ///< the material's beta; 0 when the source has none
-  std::string description;  ///< e.g. "material wood variant 3 seed 0", "normal map X (cached)"
-  std::string warning;      ///< non-empty when something worked only in part (cache not writable)
+  /// The beta this texture comes with, 0 when the source has none: a material's beta (mm), or
+  /// 1 for a physical-scale atlas (heights already in mm: beta is a gain).
+  double beta_mm = 0.0;
+  bool physical_scale = false;  ///< the atlas holds millimetres (a mesh's own texture)
+  std::string description;      ///< e.g. "material wood variant 3 seed 0", "normal map X (cached)"
+  std::string warning;  ///< non-empty when something worked only in part (cache not writable)
 };
 
 /// A normal map (baked through the AtlasCache), an atlas file, or with neither the mesh's own
-/// normal texture. Throws Error naming the file, or when `source` names a material.
+/// normal texture: a file next to the mesh or embedded in it (GLB "*N"). The mesh's own
+/// texture is baked for the mesh (bakeHeightAtlasForMesh: its UV charts as islands, offsets
+/// matched at seams) at physical scale, so H_global is in mm and beta_mm is 1; a file texture
+/// through the AtlasCache under a key that covers the mesh, an embedded one from memory. Throws Error naming the file for a given normal map or atlas,
+/// or when `source` names a material; the mesh's own texture, when missing or unusable, gives no
+/// atlas and a warning naming it as the mesh's normal texture (the mesh still renders).
 ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& mesh);
 
 /// Loads or bakes the texture. A procedural material is generated for `mesh`'s UV layout (a mesh

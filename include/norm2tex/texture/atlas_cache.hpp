@@ -3,8 +3,10 @@
 #include <optional>
 #include <string>
 
+#include "norm2tex/mesh/textured_mesh.hpp"
 #include "norm2tex/texture/height_atlas.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/mesh_bake.hpp"
 
 namespace norm2tex {
 
@@ -12,8 +14,9 @@ namespace norm2tex {
 ///
 /// The key is a hash of everything the bake depends on: the bytes of the normal map and of the
 /// mask file, every BakeOptions field and the cache format version (not the path: moving a file
-/// keeps its entry). An entry is three files in the cache directory: `<key>.tiff` (H_global,
-/// 32-bit float), `<key>.valid.png` (mask) and `<key>.yaml` (metadata: source path and hash,
+/// keeps its entry). An entry is four files in the cache directory: `<key>.tiff` (H_global,
+/// 32-bit float), `<key>.valid.png` (mask), `<key>.islands.png` (the bake's island labels,
+/// 16-bit) and `<key>.yaml` (metadata: source path and hash,
 /// convention, parameters, island count), each written to a temporary name and renamed, the
 /// yaml last, so a crash mid-write leaves no entry that looks complete.
 class AtlasCache {
@@ -24,9 +27,10 @@ class AtlasCache {
   /// $NORM2TEX_CACHE_DIR, else $XDG_CACHE_HOME/norm2tex, else $HOME/.cache/norm2tex.
   static std::string defaultDirectory();
 
-  /// Throws Error if a file cannot be read.
+  /// Throws Error if a file cannot be read. With `mesh`, the key also covers the mesh's
+  /// positions, triangles and UVs (a bake for the mesh: bakeHeightAtlasForMesh).
   std::string key(const std::string& normal_map_path, const std::string& mask_path,
-                  const BakeOptions& options) const;
+                  const BakeOptions& options, const TexturedMesh* mesh = nullptr) const;
 
   /// The cached atlas for `key`, or nothing if absent or unreadable (a damaged entry is a miss).
   std::optional<HeightAtlas> load(const std::string& key) const;
@@ -42,12 +46,16 @@ class AtlasCache {
     /// Non-empty when the bake succeeded but could not be stored (read-only or full disk):
     /// the atlas is still good, the next start will bake again.
     std::string store_error;
+    /// What the mesh bake did (charts, scale, seams); filled when baked for a mesh now.
+    MeshBakeReport mesh_report;
   };
 
-  /// Cached atlas if present, else NormalMap::load + bakeHeightAtlas + store. Throws Error for
-  /// bad input (the normal map or mask cannot be used), never for a cache that cannot be written.
+  /// Cached atlas if present, else NormalMap::load + bakeHeightAtlas (bakeHeightAtlasForMesh
+  /// with `mesh`) + store. Throws Error for bad input (the normal map, mask or mesh cannot be
+  /// used), never for a cache that cannot be written.
   Result loadOrBake(const std::string& normal_map_path, const std::string& mask_path,
-                    const BakeOptions& options, const BakeProgress& progress = {}) const;
+                    const BakeOptions& options, const BakeProgress& progress = {},
+                    const TexturedMesh* mesh = nullptr) const;
 
   const std::string& directory() const { return directory_; }
 

@@ -25,9 +25,16 @@ enum class UvWrap {
 class HeightAtlas {
  public:
   HeightAtlas() = default;
-  /// `heights` CV_32FC1, `valid` CV_8UC1 of the same size (non-zero = valid). Invalid texels
-  /// of `heights` are set to 0. Throws Error on empty or mismatched input.
+  /// `heights` CV_32FC1, `valid` CV_8UC1 of the same size (non-zero = valid). Texels whose
+  /// height is NaN or infinite are invalid, whatever `valid` says; invalid texels are 0. The
+  /// islands are the 4-connected components of the valid texels. The atlas owns its data: a
+  /// matrix still shared with the caller is copied (move it in to avoid the copy), so a later
+  /// write by the caller never changes the atlas. Throws Error on empty or mismatched input.
   HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, UvWrap wrap = UvWrap::kRepeat);
+  /// As above with the islands given (the bake's, or a mesh's UV charts): `island_labels`
+  /// CV_32SC1, 0 outside every island, 1..N inside; non-zero exactly on the valid texels.
+  HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, cv::Mat1i island_labels,
+              UvWrap wrap = UvWrap::kRepeat);
 
   /// H_global at (u, v); `valid` (optional) tells whether any texel of an island was found.
   float sample(double u, double v, bool* valid = nullptr) const {
@@ -70,7 +77,7 @@ class HeightAtlas {
   int cols() const { return heights_.cols; }
   const cv::Mat1f& heights() const { return heights_; }
   const cv::Mat1b& valid() const { return valid_; }
-  /// 0 outside islands, 1..islandCount() inside (4-connected, see findUvIslands).
+  /// 0 outside islands, 1..islandCount() inside.
   const cv::Mat1i& islandLabels() const { return labels_; }
   int islandCount() const { return island_count_; }
   UvWrap wrap() const { return wrap_; }
@@ -90,6 +97,8 @@ class HeightAtlas {
   }
   /// Bilinear look-up near an island's border or the map's edge (x0, y0 in [-1, size - 1]).
   float sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const;
+  /// Checks sizes, masks non-finite heights, zeroes invalid texels, builds interior_.
+  void finish();
 
   cv::Mat1f heights_;
   cv::Mat1b valid_;

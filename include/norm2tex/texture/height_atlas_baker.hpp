@@ -24,7 +24,31 @@ struct BakeOptions {
   /// surface is the mesh's geometry, which H_sensor already has.
   bool remove_mean_slope = true;
   IntegrationOptions integration;
+  /// Relief, not drift. Integrating a real normal map accumulates long-wavelength drift (its
+  /// small slope biases add up over hundreds of texels); normalised by percentiles, the drift
+  /// takes the whole range and the fine relief inside a contact vanishes. Geometry at the
+  /// scale of millimetres is the mesh's, which H_sensor already has, so wavelengths longer
+  /// than the cutoff are removed from each island before normalisation (Gaussian high-pass,
+  /// half gain at the cutoff). The cutoff is relief_cutoff_mm on the surface when
+  /// mm_per_texel is known, else relief_cutoff_texels. 0 keeps every wavelength (the paper).
+  double relief_cutoff_mm = 2.0;
+  double relief_cutoff_texels = 64.0;
+  /// Millimetres of surface per texel (from a mesh's UVs, or the texture's known size);
+  /// 0 = unknown.
+  double mm_per_texel = 0.0;
+  /// Physical scale: a normal map's slopes are dh/dx, so with mm_per_texel the integrated
+  /// height is in millimetres. H_global is then that height in mm (no percentile stretch; the
+  /// range only sets which end is 0: peaks at 0 for 0,-1, valleys at 0 for 0,1, zero mean for
+  /// -1,1), and beta becomes a gain (1 = the relief the normal map implies).
+  bool physical_scale = false;
 };
+
+/// The paper's bake and nothing more: no relief high-pass, no mean-slope removal, the periodic
+/// Fourier solve. For comparisons; real normal maps bake mostly to drift with it.
+BakeOptions paperExactBakeOptions();
+
+/// The relief cutoff in texels these options imply (0 = none).
+double reliefCutoffTexels(const BakeOptions& options);
 
 /// Throws Error naming the first parameter out of range and its valid range.
 void validate(const BakeOptions& options);
@@ -37,12 +61,22 @@ struct BakeReport {
   int island_count = 0;
   int valid_texels = 0;
   cv::Vec2f percentile_values;  ///< blended height at percentile_low / percentile_high
+  int poisson_solves = 0;       ///< cosine/Fourier solves over all islands (1 per full box)
+  double worst_relative_residual = 0.0;  ///< of the islands' conjugate-gradient solves
+  int unconverged_islands = 0;        ///< islands whose solve hit max_iterations before tolerance
+  double relief_cutoff_texels = 0.0;  ///< the high-pass cutoff used, 0 = none
+  /// (percentile_high - percentile_low) value x mm_per_texel: the relief amplitude the normal
+  /// map implies, mm; 0 when mm_per_texel is unknown.
+  double relief_amplitude_mm = 0.0;
 };
 
 /// H_global from a decoded normal map: for every UV island on its own, a fine and a coarse
-/// pass (mask-aware Gaussian of the normals, gradients, Frankot-Chellappa), blended with
-/// alpha; then one percentile normalisation over all valid texels into `range`. Texels outside
-/// every island are 0 and invalid. Deterministic: same input and options, same bits.
+/// pass (mask-aware Gaussian of the normals, gradients), blended with alpha and integrated
+/// once (Frankot-Chellappa is linear: the same as integrating each pass and blending the
+/// heights), its wavelengths above the relief cutoff removed; then one percentile
+/// normalisation over all valid texels into `range` (or the physical scale). Texels outside
+/// every island are 0 and invalid; the atlas gets the bake's island labels.
+/// Deterministic: same input and options, same bits.
 HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& options = {},
                             const BakeProgress& progress = {}, BakeReport* report = nullptr);
 

@@ -8,6 +8,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/image_file_check.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -30,21 +31,57 @@ cv::Mat readImage(const std::string& path, int flags, const std::string& what) {
     throw Error(what + " '" + path + "' cannot be opened (permissions?)");
   }
   if (fs::file_size(path, ec) == 0) throw Error(what + " '" + path + "' is an empty file");
+  // One read of the whole file: checked for completeness, then decoded from memory.
+  std::vector<unsigned char> bytes(static_cast<size_t>(fs::file_size(path, ec)));
+  {
+    std::ifstream file(path, std::ios::binary);
+    file.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!file || ec) throw Error(what + " '" + path + "' cannot be read");
+  }
+  return decodeImage(bytes, flags, what + " '" + path + "'");
+}
+
+cv::Mat decodeImage(const std::vector<unsigned char>& bytes, int flags, const std::string& what) {
+  if (bytes.empty()) throw Error(what + " is empty");
+  if (const std::string reason = detail::incompleteImageReason(bytes); !reason.empty()) {
+    throw Error(what + " is corrupt: " + reason);
+  }
   cv::Mat image;
   try {
-    image = cv::imread(path, flags);
+    image = cv::imdecode(bytes, flags);
   } catch (const cv::Exception& e) {
-    throw Error(what + " '" + path + "' cannot be decoded: " + e.what());
+    throw Error(what + " cannot be decoded: " + e.what());
   }
   if (image.empty()) {
-    throw Error(what + " '" + path +
-                "' cannot be decoded (corrupt, truncated or not a PNG/JPEG/TIFF image)");
+    throw Error(what + " cannot be decoded (corrupt, truncated or not a PNG/JPEG/TIFF image)");
   }
   return image;
 }
 
+void requireFormatHolds(const std::string& path, int type) {
+  const std::string extension = lowerCaseExtension(path);
+  const int depth = CV_MAT_DEPTH(type);
+  const bool float_data = depth == CV_32F || depth == CV_64F;
+  const bool float_format = extension == ".tiff" || extension == ".tif" || extension == ".exr" ||
+                            extension == ".pfm" || extension == ".hdr";
+  const bool sixteen_bit_format = float_format || extension == ".png" || extension == ".pgm" ||
+                                  extension == ".ppm" || extension == ".pnm";
+  // OpenCV would convert silently: float depth in metres to PNG saturates to 0 or 1.
+  if (float_data && !float_format) {
+    throw Error("cannot write floating-point data to '" + path +
+                "': " + (extension.empty() ? std::string("no extension") : extension) +
+                " holds only integers; use .tiff");
+  }
+  if (depth == CV_16U && !sixteen_bit_format) {
+    throw Error("cannot write 16-bit data to '" + path +
+                "': " + (extension.empty() ? std::string("no extension") : extension) +
+                " holds only 8 bits; use .png or .tiff");
+  }
+}
+
 void writeImage(const std::string& path, const cv::Mat& image) {
   if (image.empty()) throw Error("refusing to write an empty image to '" + path + "'");
+  requireFormatHolds(path, image.type());
   const fs::path target(path);
   std::error_code ec;
   if (target.has_parent_path() && !fs::is_directory(target.parent_path(), ec)) {

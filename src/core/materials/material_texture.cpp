@@ -112,6 +112,10 @@ HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, 
       *material, computeUvLayout(mesh, cv::Size(config.size, config.size)), CV_16U, padding_texels);
   BakeOptions options;
   options.range = config.range;
+  // No relief high-pass: a procedural normal map is the exact slope of a designed height, so
+  // integration accumulates no drift, and its long features (wood rings mm apart) are texture.
+  options.relief_cutoff_mm = 0.0;
+  options.relief_cutoff_texels = 0.0;
   return bakeHeightAtlas(NormalMap::fromImage(texture.normal_map, options.normal_map), options);
 }
 

@@ -78,6 +78,17 @@ std::string resolveTexture(const std::string& reference, const aiScene& scene,
   return texture.lexically_normal().string();
 }
 
+// The file bytes of an embedded texture ("*N" or a name assimp knows as embedded). Compressed
+// textures (PNG, JPEG: what glTF embeds) are the file itself; uncompressed ones (mHeight > 0,
+// BGRA texels, from some FBX) are not supported and give no bytes.
+std::vector<unsigned char> embeddedTexture(const std::string& reference, const aiScene& scene) {
+  if (reference.empty()) return {};
+  const aiTexture* texture = scene.GetEmbeddedTexture(reference.c_str());
+  if (texture == nullptr || texture->mHeight != 0 || texture->pcData == nullptr) return {};
+  const auto* bytes = reinterpret_cast<const unsigned char*>(texture->pcData);
+  return std::vector<unsigned char>(bytes, bytes + texture->mWidth);
+}
+
 }  // namespace
 
 TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& options) {
@@ -219,6 +230,8 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
   }
   const fs::path directory = fs::absolute(fs::path(path), ec).parent_path();
   result.normal_texture_path_ = resolveTexture(texture_reference, *scene, directory);
+  result.normal_texture_reference_ = texture_reference;
+  result.embedded_normal_texture_ = embeddedTexture(texture_reference, *scene);
   result.source_path_ = path;
   return result;
 }

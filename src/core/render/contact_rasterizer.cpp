@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "norm2tex/common/error.hpp"
@@ -39,6 +40,167 @@ void resetRaster(cv::Size size, bool want_uv, ContactRaster& out) {
   }
   out.covered_box = cv::Rect();
   out.triangles_rasterized = 0;
+  out.pixel_hits = 0;
+}
+
+/// A triangle in continuous pixel coordinates (centres at integers), with its heights (mm)
+/// and UVs at the corners.
+struct ProjectedTriangle {
+  float x[3], y[3], z[3];
+  Eigen::Vector2f uv[3];
+};
+
+struct CoveredBox {
+  int min_r, max_r, min_c, max_c;
+};
+
+/// Fixed point with 8 fractional bits: 1/256 pixel, as GPUs snap.
+constexpr double kSubpixel = 256.0;
+constexpr double kMaxFixedPixels = double(1 << 22);  // |products| < 2^62: no int64 overflow
+
+/// Edge v_i -> v_j of a triangle with positive area (y down): the interior is where
+/// E(p) = (x_j - x_i)(p_y - y_i) - (y_j - y_i)(p_x - x_i) > 0. A centre with E = 0 belongs to
+/// the triangle when the edge is a top edge (horizontal, dx > 0) or a left edge (dy < 0): the
+/// rule flips with the edge's direction, and a shared edge runs opposite ways in its two
+/// triangles, so exactly one of them owns the centre.
+template <typename T>
+struct Edge {
+  T dx, dy, x0, y0;
+  bool owns_boundary;
+  Edge(T xi, T yi, T xj, T yj)
+      : dx(xj - xi), dy(yj - yi), x0(xi), y0(yi), owns_boundary(dy < 0 || (dy == 0 && dx > 0)) {}
+  T at(T px, T py) const { return dx * (py - y0) - dy * (px - x0); }
+  bool inside(T value) const { return value > 0 || (value == 0 && owns_boundary); }
+};
+
+struct PixelRange {
+  int c_begin, c_end, r_begin, r_end;
+};
+
+template <typename T>
+bool fillTriangle(const T* x, const T* y, T one_pixel, const ProjectedTriangle& triangle, int face,
+                  float reach, bool want_uv, const PixelRange& range,
+                  const cv::Mat1f& gel_surface_mm, ContactRaster& out, CoveredBox& covered);
+
+/// Smallest integer >= value / unit (unit > 0), for integers and doubles alike.
+std::int64_t ceilDiv(std::int64_t value, std::int64_t unit) {
+  return value >= 0 ? (value + unit - 1) / unit : -((-value) / unit);
+}
+std::int64_t floorDiv(std::int64_t value, std::int64_t unit) {
+  return value >= 0 ? value / unit : -((-value + unit - 1) / unit);
+}
+std::int64_t ceilDiv(double value, double unit) {
+  return static_cast<std::int64_t>(std::ceil(value / unit));
+}
+std::int64_t floorDiv(double value, double unit) {
+  return static_cast<std::int64_t>(std::floor(value / unit));
+}
+
+/// The pixel centres inside the (snapped) corners' bounding box, clipped to the image.
+template <typename T>
+bool pixelRange(const T* x, const T* y, T one_pixel, cv::Size image, PixelRange& range) {
+  range.c_begin =
+      static_cast<int>(std::max<std::int64_t>(0, ceilDiv(std::min({x[0], x[1], x[2]}), one_pixel)));
+  range.c_end = static_cast<int>(
+      std::min<std::int64_t>(image.width - 1, floorDiv(std::max({x[0], x[1], x[2]}), one_pixel)));
+  range.r_begin =
+      static_cast<int>(std::max<std::int64_t>(0, ceilDiv(std::min({y[0], y[1], y[2]}), one_pixel)));
+  range.r_end = static_cast<int>(
+      std::min<std::int64_t>(image.height - 1, floorDiv(std::max({y[0], y[1], y[2]}), one_pixel)));
+  return range.c_begin <= range.c_end && range.r_begin <= range.r_end;
+}
+
+/// Depth-tests and writes the pixels whose centres the triangle covers. False when it covers
+/// no pixel range at all (off the image or of zero area).
+bool drawTriangle(const ProjectedTriangle& triangle, int face, float reach, bool want_uv,
+                  const cv::Mat1f& gel_surface_mm, ContactRaster& out, CoveredBox& covered) {
+  const float* x = triangle.x;
+  const float* y = triangle.y;
+  // Quick rejection with a pixel of margin (snapping moves corners by 1/512 pixel at most).
+  const float min_x = std::min({x[0], x[1], x[2]}), max_x = std::max({x[0], x[1], x[2]});
+  const float min_y = std::min({y[0], y[1], y[2]}), max_y = std::max({y[0], y[1], y[2]});
+  if (max_x < -1.0f || max_y < -1.0f || min_x > gel_surface_mm.cols ||
+      min_y > gel_surface_mm.rows) {
+    return false;
+  }
+  const bool fixed_point = std::max({std::fabs(min_x), std::fabs(max_x), std::fabs(min_y),
+                                     std::fabs(max_y)}) < kMaxFixedPixels;
+  PixelRange range;
+  if (fixed_point) {
+    std::int64_t fx[3], fy[3];
+    for (int k = 0; k < 3; ++k) {
+      fx[k] = std::llround(x[k] * kSubpixel);
+      fy[k] = std::llround(y[k] * kSubpixel);
+    }
+    const auto one = static_cast<std::int64_t>(kSubpixel);
+    if (!pixelRange<std::int64_t>(fx, fy, one, gel_surface_mm.size(), range)) return false;
+    return fillTriangle<std::int64_t>(fx, fy, one, triangle, face, reach, want_uv, range,
+                                      gel_surface_mm, out, covered);
+  }
+  double dx[3], dy[3];
+  for (int k = 0; k < 3; ++k) {
+    dx[k] = x[k];
+    dy[k] = y[k];
+  }
+  if (!pixelRange<double>(dx, dy, 1.0, gel_surface_mm.size(), range)) return false;
+  return fillTriangle<double>(dx, dy, 1.0, triangle, face, reach, want_uv, range, gel_surface_mm,
+                              out, covered);
+}
+
+template <typename T>
+bool fillTriangle(const T* x, const T* y, T one_pixel, const ProjectedTriangle& triangle, int face,
+                  float reach, bool want_uv, const PixelRange& range,
+                  const cv::Mat1f& gel_surface_mm, ContactRaster& out, CoveredBox& covered) {
+  // Orient to positive area; a triangle of zero area covers no centre.
+  int order[3] = {0, 1, 2};
+  T area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+  if (area == 0) return false;
+  if (area < 0) {
+    std::swap(order[1], order[2]);
+    area = -area;
+  }
+  const int i0 = order[0], i1 = order[1], i2 = order[2];
+  // Edge k is opposite corner k: its function is corner k's barycentric weight times the area.
+  const Edge<T> edges[3] = {Edge<T>(x[i1], y[i1], x[i2], y[i2]),
+                            Edge<T>(x[i2], y[i2], x[i0], y[i0]),
+                            Edge<T>(x[i0], y[i0], x[i1], y[i1])};
+  const float z[3] = {triangle.z[i0], triangle.z[i1], triangle.z[i2]};
+  const Eigen::Vector2f uv[3] = {triangle.uv[i0], triangle.uv[i1], triangle.uv[i2]};
+  const double inverse_area = 1.0 / static_cast<double>(area);
+  for (int r = range.r_begin; r <= range.r_end; ++r) {
+    float* gap_row = out.gap_mm.ptr<float>(r);
+    int* face_row = out.face.ptr<int>(r);
+    const float* gel_row = gel_surface_mm.ptr<float>(r);
+    cv::Vec2f* uv_row = want_uv ? out.uv.ptr<cv::Vec2f>(r) : nullptr;
+    const T py = static_cast<T>(r) * one_pixel;
+    // Edge functions step by -dy per column: exact in integers.
+    T e[3], step[3];
+    for (int k = 0; k < 3; ++k) {
+      e[k] = edges[k].at(static_cast<T>(range.c_begin) * one_pixel, py);
+      step[k] = -edges[k].dy * one_pixel;
+    }
+    for (int col = range.c_begin; col <= range.c_end;
+         ++col, e[0] += step[0], e[1] += step[1], e[2] += step[2]) {
+      if (!edges[0].inside(e[0]) || !edges[1].inside(e[1]) || !edges[2].inside(e[2])) continue;
+      ++out.pixel_hits;
+      const float w0 = static_cast<float>(static_cast<double>(e[0]) * inverse_area);
+      const float w1 = static_cast<float>(static_cast<double>(e[1]) * inverse_area);
+      const float w2 = 1.0f - w0 - w1;
+      const float gap = w0 * z[0] + w1 * z[1] + w2 * z[2] - gel_row[col];
+      if (gap >= gap_row[col] || gap > reach) continue;
+      gap_row[col] = gap;
+      face_row[col] = face;
+      if (uv_row != nullptr) {
+        const Eigen::Vector2f q = w0 * uv[0] + w1 * uv[1] + w2 * uv[2];
+        uv_row[col] = cv::Vec2f(q.x(), q.y());
+      }
+      covered.min_r = std::min(covered.min_r, r);
+      covered.max_r = std::max(covered.max_r, r);
+      covered.min_c = std::min(covered.min_c, col);
+      covered.max_c = std::max(covered.max_c, col);
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -75,8 +237,8 @@ void ContactRasterizer::rasterize(const TexturedMesh& mesh, const Eigen::Isometr
       Eigen::Vector3f(static_cast<float>(half_w), static_cast<float>(half_h),
                       static_cast<float>(1e-3 * reach_mm)));
   const Eigen::Isometry3f pose = object_in_gel.cast<float>();
-  candidates_.clear();
-  mesh.queryTriangles(pose, region, candidates_);
+  out.candidates.clear();
+  mesh.queryTriangles(pose, region, out.candidates);
 
   // Gel-frame mm -> continuous pixel coordinates with pixel centres at integers.
   const float px_per_m = static_cast<float>(1e3 / model_.mm_per_pixel);
@@ -84,71 +246,25 @@ void ContactRasterizer::rasterize(const TexturedMesh& mesh, const Eigen::Isometr
   const float reach = static_cast<float>(reach_mm);
   const auto& vertices = mesh.vertices();
   const auto& uvs = mesh.uvs();
-  int min_r = model_.rows, max_r = -1, min_c = model_.cols, max_c = -1;
+  CoveredBox covered{model_.rows, -1, model_.cols, -1};
 
-  for (const int t : candidates_) {
+  for (const int t : out.candidates) {
     const Eigen::Vector3i& tri = mesh.triangles()[t];
-    Eigen::Vector3f p[3];
-    for (int k = 0; k < 3; ++k) p[k] = pose * vertices[tri[k]];
-    // Pixel-space x (column), y (row) and height z (mm) of the three corners.
-    float x[3], y[3], z[3];
+    ProjectedTriangle triangle;
     for (int k = 0; k < 3; ++k) {
-      x[k] = p[k].x() * px_per_m + col0;
-      y[k] = p[k].y() * px_per_m + row0;
-      z[k] = p[k].z() * 1e3f;
+      const Eigen::Vector3f p = pose * vertices[tri[k]];
+      triangle.x[k] = p.x() * px_per_m + col0;
+      triangle.y[k] = p.y() * px_per_m + row0;
+      triangle.z[k] = p.z() * 1e3f;
+      triangle.uv[k] = want_uv ? uvs[tri[k]] : Eigen::Vector2f::Zero();
     }
-    if (std::min({z[0], z[1], z[2]}) > reach) continue;  // the gel surface is at or below 0
-    const float area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
-    if (std::abs(area) < 1e-8f) continue;  // seen edge-on: its neighbours cover these pixels
-    const int c_begin = std::max(0, static_cast<int>(std::ceil(std::min({x[0], x[1], x[2]}))));
-    const int c_end =
-        std::min(model_.cols - 1, static_cast<int>(std::floor(std::max({x[0], x[1], x[2]}))));
-    const int r_begin = std::max(0, static_cast<int>(std::ceil(std::min({y[0], y[1], y[2]}))));
-    const int r_end =
-        std::min(model_.rows - 1, static_cast<int>(std::floor(std::max({y[0], y[1], y[2]}))));
-    if (c_begin > c_end || r_begin > r_end) continue;
-    ++out.triangles_rasterized;
-
-    // Barycentric weights are affine in (column, row): w_k = a_k * column + b_k * row + c_k.
-    const float inv = 1.0f / area;
-    float a[3], b[3], c0[3];
-    for (int k = 0; k < 3; ++k) {
-      const int i = (k + 1) % 3, j = (k + 2) % 3;
-      a[k] = (y[i] - y[j]) * inv;
-      b[k] = (x[j] - x[i]) * inv;
-      c0[k] = (x[i] * y[j] - x[j] * y[i]) * inv;
-    }
-    Eigen::Vector2f uv[3] = {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(),
-                             Eigen::Vector2f::Zero()};
-    if (want_uv) {
-      for (int k = 0; k < 3; ++k) uv[k] = uvs[tri[k]];
-    }
-    for (int r = r_begin; r <= r_end; ++r) {
-      float* gap_row = out.gap_mm.ptr<float>(r);
-      int* face_row = out.face.ptr<int>(r);
-      const float* gel_row = gel_surface_mm_.ptr<float>(r);
-      cv::Vec2f* uv_row = want_uv ? out.uv.ptr<cv::Vec2f>(r) : nullptr;
-      for (int col = c_begin; col <= c_end; ++col) {
-        const float w0 = a[0] * col + b[0] * r + c0[0];
-        const float w1 = a[1] * col + b[1] * r + c0[1];
-        const float w2 = 1.0f - w0 - w1;
-        // Small tolerance so pixel centres exactly on a shared edge are never dropped.
-        if (w0 < -1e-6f || w1 < -1e-6f || w2 < -1e-6f) continue;
-        const float gap = w0 * z[0] + w1 * z[1] + w2 * z[2] - gel_row[col];
-        if (gap >= gap_row[col] || gap > reach) continue;
-        gap_row[col] = gap;
-        face_row[col] = t;
-        if (uv_row != nullptr) {
-          const Eigen::Vector2f q = w0 * uv[0] + w1 * uv[1] + w2 * uv[2];
-          uv_row[col] = cv::Vec2f(q.x(), q.y());
-        }
-        min_r = std::min(min_r, r);
-        max_r = std::max(max_r, r);
-        min_c = std::min(min_c, col);
-        max_c = std::max(max_c, col);
-      }
+    if (std::min({triangle.z[0], triangle.z[1], triangle.z[2]}) > reach) continue;
+    if (drawTriangle(triangle, t, reach, want_uv, gel_surface_mm_, out, covered)) {
+      ++out.triangles_rasterized;
     }
   }
+  const int min_r = covered.min_r, max_r = covered.max_r;
+  const int min_c = covered.min_c, max_c = covered.max_c;
   if (max_r < 0) return;
   out.covered_box = cv::Rect(min_c, min_r, max_c - min_c + 1, max_r - min_r + 1);
 

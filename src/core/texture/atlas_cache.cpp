@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // Bump when the bake's output for the same input and options changes.
-constexpr int kFormatVersion = 1;
+constexpr int kFormatVersion = 2;  // 2: exact least squares, island labels, relief cutoff
 
 std::string describeOptions(const BakeOptions& o) {
   std::ostringstream text;
@@ -27,9 +27,12 @@ std::string describeOptions(const BakeOptions& o) {
        << ";sigma_fine=" << o.sigma_fine << ";sigma_coarse=" << o.sigma_coarse
        << ";alpha=" << o.alpha << ";percentile_low=" << o.percentile_low
        << ";percentile_high=" << o.percentile_high << ";range=" << toString(o.range) << ";boundary="
-       << (o.integration.boundary == PoissonBoundary::kMirror ? "mirror" : "periodic")
-       << ";apron_refinements=" << o.integration.apron_refinements
-       << ";remove_mean_slope=" << o.remove_mean_slope;
+       << (o.integration.boundary == PoissonBoundary::kNeumann ? "neumann" : "periodic")
+       << ";tolerance=" << o.integration.tolerance
+       << ";max_iterations=" << o.integration.max_iterations
+       << ";remove_mean_slope=" << o.remove_mean_slope << ";relief_cutoff_mm=" << o.relief_cutoff_mm
+       << ";relief_cutoff_texels=" << o.relief_cutoff_texels << ";mm_per_texel=" << o.mm_per_texel
+       << ";physical_scale=" << o.physical_scale;
   return text.str();
 }
 
@@ -56,11 +59,22 @@ std::string AtlasCache::defaultDirectory() {
 }
 
 std::string AtlasCache::key(const std::string& normal_map_path, const std::string& mask_path,
-                            const BakeOptions& options) const {
+                            const BakeOptions& options, const TexturedMesh* mesh) const {
   std::uint64_t hash = fnv1a64("norm2tex-atlas-v" + std::to_string(kFormatVersion));
   hash = fnv1a64(hashFile(normal_map_path), hash);
   hash = fnv1a64(mask_path.empty() ? std::string("no-mask") : hashFile(mask_path), hash);
   hash = fnv1a64(describeOptions(options), hash);
+  if (mesh != nullptr) {
+    // What a mesh bake depends on: UV layout (charts), 3-D areas (scale) and seams.
+    const auto bytes = [](const auto& items) {
+      return std::string(reinterpret_cast<const char*>(items.data()),
+                         items.size() * sizeof(items[0]));
+    };
+    hash = fnv1a64("mesh", hash);
+    hash = fnv1a64(bytes(mesh->vertices()), hash);
+    hash = fnv1a64(bytes(mesh->triangles()), hash);
+    hash = fnv1a64(bytes(mesh->uvs()), hash);
+  }
   return toHex(hash);
 }
 
@@ -74,11 +88,16 @@ std::optional<HeightAtlas> AtlasCache::load(const std::string& key) const {
     const cv::Mat heights = cv::imread(entryPath(directory_, key, ".tiff"), cv::IMREAD_UNCHANGED);
     const cv::Mat valid =
         cv::imread(entryPath(directory_, key, ".valid.png"), cv::IMREAD_GRAYSCALE);
+    const cv::Mat labels =
+        cv::imread(entryPath(directory_, key, ".islands.png"), cv::IMREAD_UNCHANGED);
     if (heights.empty() || heights.type() != CV_32FC1 || valid.size() != heights.size() ||
+        labels.type() != CV_16UC1 || labels.size() != heights.size() ||
         heights.rows != metadata["rows"].as<int>() || heights.cols != metadata["cols"].as<int>()) {
       return std::nullopt;
     }
-    return HeightAtlas(heights, valid);
+    cv::Mat1i island_labels;
+    labels.convertTo(island_labels, CV_32S);
+    return HeightAtlas(heights, valid, island_labels);
   } catch (const std::exception&) {
     return std::nullopt;  // a damaged entry is a miss; the next store replaces it
   }
@@ -92,6 +111,15 @@ void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
   if (ec) throw Error("cannot create cache directory '" + directory_ + "': " + ec.message());
   writeImage(entryPath(directory_, key, ".tiff"), atlas.heights());
   writeImage(entryPath(directory_, key, ".valid.png"), atlas.valid());
+  // Island labels as 16-bit PNG: they are the bake's islands, not recomputable from the mask
+  // once islands come from a mesh's UV charts.
+  if (atlas.islandCount() > 65535) {
+    throw Error("cannot cache an atlas of " + std::to_string(atlas.islandCount()) +
+                " islands (at most 65535)");
+  }
+  cv::Mat labels;
+  atlas.islandLabels().convertTo(labels, CV_16U);
+  writeImage(entryPath(directory_, key, ".islands.png"), labels);
 
   YAML::Emitter yaml;
   yaml << YAML::BeginMap;
@@ -128,17 +156,23 @@ void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
 
 AtlasCache::Result AtlasCache::loadOrBake(const std::string& normal_map_path,
                                           const std::string& mask_path, const BakeOptions& options,
-                                          const BakeProgress& progress) const {
-  validate(options);
+                                          const BakeProgress& progress,
+                                          const TexturedMesh* mesh) const {
+  // A mesh bake learns mm per texel from the mesh (and checks the physical scale then).
+  BakeOptions checked = options;
+  if (mesh != nullptr) checked.physical_scale = false;
+  validate(checked);
   Result result;
-  const std::string cache_key = key(normal_map_path, mask_path, options);
+  const std::string cache_key = key(normal_map_path, mask_path, options, mesh);
   if (std::optional<HeightAtlas> cached = load(cache_key)) {
     result.atlas = std::move(*cached);
     result.was_cached = true;
     return result;
   }
   const NormalMap normal_map = NormalMap::load(normal_map_path, options.normal_map, mask_path);
-  result.atlas = bakeHeightAtlas(normal_map, options, progress);
+  result.atlas = mesh != nullptr ? bakeHeightAtlasForMesh(normal_map, *mesh, options, progress,
+                                                          &result.mesh_report)
+                                 : bakeHeightAtlas(normal_map, options, progress);
   try {
     store(cache_key, result.atlas, normal_map_path, mask_path, options);
   } catch (const Error& e) {

@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 
 namespace norm2tex {
 
@@ -10,6 +11,7 @@ UvIslands findUvIslands(const cv::Mat1b& valid) {
   if (valid.empty()) throw Error("findUvIslands: empty mask");
   UvIslands result;
   cv::Mat stats, centroids;
+  createWithHugePages(result.labels, valid.rows, valid.cols);  // a bake's largest label map
   const int count =
       cv::connectedComponentsWithStats(valid, result.labels, stats, centroids, 4, CV_32S);
   result.islands.reserve(count > 0 ? count - 1 : 0);

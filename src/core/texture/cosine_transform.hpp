@@ -1,0 +1,43 @@
+#pragma once
+// The 2-D cosine transform (DCT-II, unnormalised) through one real cv::dft per pass: the basis
+// that diagonalises the Neumann Laplacian and Gaussian blurs with mirrored borders.
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "texture/scratch_buffer.hpp"
+
+namespace norm2tex {
+namespace detail {
+
+class CosineTransform {
+ public:
+  /// Spectrum of `x` (rows x cols, both even), laid out *transposed*: spectrum(u, v) is the
+  /// coefficient of cos(pi u (c + 1/2) / cols) cos(pi v (r + 1/2) / rows). Returns a view
+  /// of internal memory, valid until the next call.
+  cv::Mat1f& forward(const cv::Mat1f& x);
+  /// Inverse of forward(): `spectrum` must be the matrix forward() returned (it is
+  /// overwritten); writes rows x cols into `x` (which may be forward's input).
+  void inverse(cv::Mat1f& spectrum, cv::Mat1f& x);
+
+  /// The smallest even length >= n whose real DFT is fast.
+  static int transformLength(int n);
+
+ private:
+  void prepare(int rows, int cols);
+  void forwardRows(const cv::Mat1f& in, cv::Mat1f& out, const std::vector<float>& cosines,
+                   const std::vector<float>& sines);
+  void inverseRows(cv::Mat1f& in, cv::Mat1f& out, const std::vector<float>& cosines,
+                   const std::vector<float>& sines);
+
+  int rows_ = 0, cols_ = 0;
+  // Twiddles cos(pi k / 2n), sin(pi k / 2n) for k <= n / 2, per axis.
+  std::vector<float> cos_x_, sin_x_, cos_y_, sin_y_;
+  std::vector<float> row_;
+  ScratchBuffer<float> first_, second_;
+  cv::Mat1f spectrum_;
+};
+
+}  // namespace detail
+}  // namespace norm2tex

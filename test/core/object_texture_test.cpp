@@ -1,0 +1,167 @@
+// Where an object's texture comes from: a mesh's own normal texture, embedded in a GLB or a
+// file next to it, and what happens when it cannot be used.
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/render/tactile_renderer.hpp"
+#include "norm2tex/texture/analytic_surface.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/mesh_bake.hpp"
+#include "norm2tex/texture/normal_encoding.hpp"
+#include "test_helpers.hpp"
+
+namespace norm2tex {
+namespace {
+
+void append(std::vector<unsigned char>& out, const void* data, size_t size) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  out.insert(out.end(), bytes, bytes + size);
+}
+
+void appendU32(std::vector<unsigned char>& out, std::uint32_t value) {
+  append(out, &value, 4);  // GLB is little-endian, like x86
+}
+
+/// A binary glTF of one 20 x 20 mm square in the z = 0 plane, UVs over [0, 1]^2, whose material's
+/// normal texture is `png` embedded in the file ("*0") or, when `png` is empty, an external
+/// image `uri`.
+void writeSquareGlb(const std::string& path, const std::vector<unsigned char>& png,
+                    const std::string& uri = "") {
+  std::vector<unsigned char> bin;
+  const float positions[12] = {-0.01f, -0.01f, 0, 0.01f,  -0.01f, 0,
+                               0.01f,  0.01f,  0, -0.01f, 0.01f,  0};
+  const float uvs[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+  const std::uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+  append(bin, positions, sizeof(positions));
+  append(bin, uvs, sizeof(uvs));
+  append(bin, indices, sizeof(indices));
+  const size_t image_offset = bin.size();
+  append(bin, png.data(), png.size());
+  while (bin.size() % 4 != 0) bin.push_back(0);
+  const std::string image =
+      png.empty() ? "{\"uri\":\"" + uri + "\"}" : "{\"bufferView\":3,\"mimeType\":\"image/png\"}";
+  std::string json =
+      "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+      "\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},"
+      "\"indices\":2,\"material\":0}]}],"
+      "\"materials\":[{\"normalTexture\":{\"index\":0}}],"
+      "\"textures\":[{\"source\":0}],\"images\":[" +
+      image +
+      "],"
+      "\"buffers\":[{\"byteLength\":" +
+      std::to_string(bin.size()) +
+      "}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+      "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+      "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12},"
+      "{\"buffer\":0,\"byteOffset\":" +
+      std::to_string(image_offset) + ",\"byteLength\":" + std::to_string(png.size()) +
+      "}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+      "\"min\":[-0.01,-0.01,0],\"max\":[0.01,0.01,0]},"
+      "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+      "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}";
+  while (json.size() % 4 != 0) json += ' ';
+  std::vector<unsigned char> glb;
+  appendU32(glb, 0x46546C67);  // "glTF"
+  appendU32(glb, 2);
+  appendU32(glb, static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size()));
+  appendU32(glb, static_cast<std::uint32_t>(json.size()));
+  appendU32(glb, 0x4E4F534A);  // "JSON"
+  append(glb, json.data(), json.size());
+  appendU32(glb, static_cast<std::uint32_t>(bin.size()));
+  appendU32(glb, 0x004E4942);  // "BIN"
+  append(glb, bin.data(), bin.size());
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(glb.data()), static_cast<std::streamsize>(glb.size()));
+}
+
+std::vector<unsigned char> ridgesPng() {
+  const AnalyticSurface s = makeRidges(cv::Size(128, 128), {0.5, 9.0, 1.5, 1.0});
+  std::vector<unsigned char> png;
+  cv::imencode(".png", encodeNormalMap(s.dx, s.dy, NormalConvention::kOpenGL, CV_8U), png);
+  return png;
+}
+
+Eigen::Isometry3d pressed(double press_mm) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(0.0, 0.0, -press_mm * 1e-3);
+  return pose;
+}
+
+TEST(ObjectTexture, EmbeddedGlbNormalTextureIsBakedAndRendersTextured) {
+  test::ScratchDirectory dir;
+  const std::vector<unsigned char> png = ridgesPng();
+  writeSquareGlb(dir.path("square.glb"), png);
+  const auto mesh =
+      std::make_shared<const TexturedMesh>(TexturedMesh::load(dir.path("square.glb")));
+  EXPECT_EQ(mesh->normalTextureReference(), "*0");
+  EXPECT_TRUE(mesh->normalTexturePath().empty()) << "no file of its own";
+  ASSERT_EQ(mesh->embeddedNormalTexture(), png) << "the PNG's own bytes";
+
+  const ObjectTexture texture = loadTextureFile({}, *mesh);
+  ASSERT_NE(texture.atlas, nullptr) << texture.warning;
+  EXPECT_TRUE(texture.warning.empty()) << texture.warning;
+  EXPECT_NE(texture.description.find("normal texture *0"), std::string::npos)
+      << texture.description;
+  // The same texels as baking the PNG for this mesh: its chart, its scale, millimetres.
+  BakeOptions physical;
+  physical.physical_scale = true;
+  MeshBakeReport report;
+  const HeightAtlas direct = bakeHeightAtlasForMesh(
+      NormalMap::fromImage(cv::imdecode(png, cv::IMREAD_UNCHANGED)), *mesh, physical, {}, &report);
+  EXPECT_EQ(cv::norm(texture.atlas->heights(), direct.heights(), cv::NORM_INF), 0.0);
+  EXPECT_TRUE(texture.physical_scale);
+  EXPECT_EQ(texture.beta_mm, 1.0) << "heights in mm: beta is a gain";
+  EXPECT_NEAR(report.mm_per_texel, 20.0 / 128.0, 1e-3) << "20 mm over 128 texels";
+  // Ridges of 1 texel height on a 0.156 mm grid: the relief is about 0.16 mm.
+  EXPECT_GT(report.bake.relief_amplitude_mm, 0.05);
+  EXPECT_LT(report.bake.relief_amplitude_mm, 0.5);
+
+  TactileRenderer renderer(makeDigitSensorModel());
+  renderer.setObject(mesh, texture.atlas, texture.beta_mm);
+  const TactileFrame textured = renderer.render(pressed(0.3), -1);
+  EXPECT_TRUE(textured.textured);
+  const cv::Mat3b textured_image = textured.image.clone();
+  renderer.setObject(mesh, nullptr, 0.0);
+  const cv::Mat3b plain = renderer.render(pressed(0.3), -1).image;
+  EXPECT_GT(cv::norm(textured_image, plain, cv::NORM_L1) / plain.total(), 1.0)
+      << "the texture shows in the image";
+}
+
+TEST(ObjectTexture, MissingOrUnusableMeshTextureIsAWarningNamingIt) {
+  test::ScratchDirectory dir;
+  writeSquareGlb(dir.path("missing.glb"), {}, "missing_normal.png");
+  const TexturedMesh missing = TexturedMesh::load(dir.path("missing.glb"));
+  ObjectTexture texture = loadTextureFile({}, missing);
+  EXPECT_EQ(texture.atlas, nullptr);
+  EXPECT_NE(texture.warning.find("mesh's normal texture 'missing_normal.png'"), std::string::npos)
+      << texture.warning;
+  EXPECT_EQ(texture.warning.find('\n'), std::string::npos);
+
+  // A truncated embedded PNG: refused, not decoded half grey.
+  std::vector<unsigned char> cut = ridgesPng();
+  cut.resize(cut.size() / 2);
+  writeSquareGlb(dir.path("cut.glb"), cut);
+  texture = loadTextureFile({}, TexturedMesh::load(dir.path("cut.glb")));
+  EXPECT_EQ(texture.atlas, nullptr);
+  EXPECT_NE(texture.warning.find("'*0'"), std::string::npos) << texture.warning;
+  EXPECT_NE(texture.warning.find("corrupt"), std::string::npos) << texture.warning;
+
+  // A normal map the user names is not the mesh's: its problems stay errors.
+  TextureSource source;
+  source.normal_map = dir.path("nope.png");
+  test::expectError([&] { loadTextureFile(source, missing); }, {"nope.png"});
+}
+
+}  // namespace
+}  // namespace norm2tex
