@@ -1,0 +1,206 @@
+#include "norm2tex/calibrate/shading_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/calibrate/ball_press.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader_response.hpp"
+#include "norm2tex/render/gel_model.hpp"
+
+namespace norm2tex {
+namespace {
+
+constexpr int kF = kShadingFeatureCount;
+
+// Normal equations of the per-channel least squares, pooled over presses.
+struct NormalEquations {
+  cv::Matx<double, kF, kF> a = cv::Matx<double, kF, kF>::zeros();
+  cv::Matx<double, kF, 3> b = cv::Matx<double, kF, 3>::zeros();
+  cv::Vec3d yy{0, 0, 0}, y_sum{0, 0, 0};
+  double count = 0.0;
+};
+
+void accumulate(const SensorModel& model, const PressObservation& press, const cv::Mat1f& gel,
+                NormalEquations& eq) {
+  const int reach = shadingReachPixels(model.mm_per_pixel, model.shading.shadow_sigma_mm);
+  cv::Rect box = cv::boundingRect(gel > 0.0f);
+  const cv::Rect image(0, 0, gel.cols, gel.rows);
+  ShadingFeatureArray features;
+  if (!box.empty()) {
+    box = cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
+          image;
+    computeShadingFeatures(gel, model.mm_per_pixel, model.shading.shadow_sigma_mm, box, features);
+  }
+  const double radius = kFitRegionRadii * press.circle.radius_px;
+  const cv::Point2d centre = press.circle.centre_px;
+  const cv::Rect region =
+      cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius), cvCeil(2 * radius) + 2,
+               cvCeil(2 * radius) + 2) &
+      image;
+  double f[kF];
+  for (int r = region.y; r < region.y + region.height; ++r) {
+    const cv::Vec3f* y_row = press.diff.ptr<cv::Vec3f>(r);
+    for (int c = region.x; c < region.x + region.width; ++c) {
+      const double dx = c - centre.x, dy = r - centre.y;
+      if (dx * dx + dy * dy > radius * radius) continue;
+      const cv::Vec3f y = y_row[c];
+      for (int k = 0; k < 3; ++k) {
+        eq.yy[k] += y[k] * y[k];
+        eq.y_sum[k] += y[k];
+      }
+      eq.count += 1.0;
+      if (!box.contains(cv::Point(c, r))) continue;  // every feature is 0 there
+      for (int j = 0; j < kF; ++j) f[j] = features[j](r - box.y, c - box.x);
+      for (int i = 0; i < kF; ++i) {
+        if (f[i] == 0.0) continue;
+        for (int j = i; j < kF; ++j) eq.a(i, j) += f[i] * f[j];
+        for (int k = 0; k < 3; ++k) eq.b(i, k) += f[i] * y[k];
+      }
+    }
+  }
+}
+
+ShadingFit solve(const NormalEquations& eq, const PressGeometry& geometry, double shadow_sigma_mm) {
+  cv::Matx<double, kF, kF> a = eq.a;
+  double trace = 0.0;
+  for (int i = 0; i < kF; ++i) {
+    for (int j = 0; j < i; ++j) a(i, j) = a(j, i);
+    trace += a(i, i);
+  }
+  // A tiny ridge keeps features that never vary (a press set without depth change) harmless.
+  for (int i = 0; i < kF; ++i) a(i, i) += 1e-9 * trace / kF + 1e-12;
+  cv::Matx<double, kF, 3> coefficients;
+  cv::solve(a, eq.b, coefficients, cv::DECOMP_CHOLESKY);
+  ShadingFit fit;
+  fit.geometry = geometry;
+  fit.shading.kind = ShadingKind::kCalibrated;
+  fit.shading.gain = 1.0;
+  fit.shading.shadow_sigma_mm = shadow_sigma_mm;
+  double sse = 0.0, sst = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    double c_b = 0.0, c_a_c = 0.0;
+    for (int i = 0; i < kF; ++i) {
+      fit.shading.response_bgr[k][i] = coefficients(i, k);
+      c_b += coefficients(i, k) * eq.b(i, k);
+      for (int j = 0; j < kF; ++j) c_a_c += coefficients(i, k) * a(i, j) * coefficients(j, k);
+    }
+    sse += eq.yy[k] - 2.0 * c_b + c_a_c;
+    sst += eq.yy[k] - eq.y_sum[k] * eq.y_sum[k] / std::max(eq.count, 1.0);
+  }
+  fit.variance_explained = sst > 0.0 ? 1.0 - sse / sst : 0.0;
+  return fit;
+}
+
+}  // namespace
+
+cv::Mat1f simulatedPressGel(const SensorModel& base, const PressCircle& circle,
+                            const PressGeometry& geometry, double ball_radius_mm) {
+  SensorModel model = base;
+  model.mm_per_pixel = geometry.mm_per_pixel;
+  PressCircle contact = circle;
+  contact.radius_px *= geometry.radius_factor;
+  const cv::Mat1f indentation = ballPressIndentation(model, contact, ball_radius_mm);
+  cv::Mat1f gel;
+  GelModel(model).apply(indentation, gel);
+  return gel;
+}
+
+ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressObservation>& presses,
+                              const PressGeometry& geometry, double ball_radius_mm,
+                              double shadow_sigma_mm) {
+  if (presses.empty()) throw Error("fitShadingResponse: no presses");
+  SensorModel model = base;
+  model.mm_per_pixel = geometry.mm_per_pixel;
+  model.shading.shadow_sigma_mm = shadow_sigma_mm;
+  NormalEquations eq;
+  for (const PressObservation& press : presses) {
+    const cv::Mat1f gel = simulatedPressGel(base, press.circle, geometry, ball_radius_mm);
+    accumulate(model, press, gel, eq);
+  }
+  return solve(eq, geometry, shadow_sigma_mm);
+}
+
+ShadingFit fitShadingAndGeometry(const SensorModel& base,
+                                 const std::vector<PressObservation>& presses,
+                                 double ball_radius_mm, std::optional<double> mm_per_pixel) {
+  if (presses.empty()) throw Error("fitShadingAndGeometry: no presses");
+  double largest_radius_px = 0.0;
+  for (const PressObservation& p : presses) largest_radius_px = std::max(largest_radius_px, p.circle.radius_px);
+  const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
+  const double scale_lo = 0.02 * qvga, scale_hi = 0.12 * qvga;
+  const double factor_lo = 0.8, factor_hi = 1.25;
+  // Largest scale at which every contact (radius x factor) still fits the ball.
+  const auto feasibleScale = [&](double factor) {
+    return 0.97 * ball_radius_mm / (factor * largest_radius_px);
+  };
+  if (mm_per_pixel && *mm_per_pixel > feasibleScale(factor_lo)) {
+    std::ostringstream message;
+    message << "the largest press (contact radius " << largest_radius_px << " px = "
+            << largest_radius_px * *mm_per_pixel << " mm at " << *mm_per_pixel
+            << " mm/px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
+            << " mm can make; check --ball-diameter-mm and --mm-per-pixel";
+    throw Error(message.str());
+  }
+  if (!mm_per_pixel && feasibleScale(factor_lo) < scale_lo) {
+    std::ostringstream message;
+    message << "the largest press (contact radius " << largest_radius_px
+            << " px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
+            << " mm can make at any plausible scale (>= " << scale_lo
+            << " mm/px); check --ball-diameter-mm";
+    throw Error(message.str());
+  }
+
+  const double default_sigma = makeDigitSensorModel().shading.shadow_sigma_mm;
+  ShadingFit best;
+  best.variance_explained = -1e300;
+  const auto tryGeometry = [&](PressGeometry g, double sigma) {
+    g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
+    if (mm_per_pixel) g.mm_per_pixel = *mm_per_pixel;
+    g.mm_per_pixel = std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
+    if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) return false;
+    const ShadingFit fit = fitShadingResponse(base, presses, g, ball_radius_mm, sigma);
+    if (fit.variance_explained <= best.variance_explained) return false;
+    best = fit;
+    return true;
+  };
+
+  // Coarse grid: factor in steps of 0.05, scale log-spaced (14 steps over the range).
+  constexpr int kScaleSteps = 14;
+  const double scale_ratio = std::pow(scale_hi / scale_lo, 1.0 / (kScaleSteps - 1));
+  for (double factor = factor_lo; factor <= factor_hi + 1e-9; factor += 0.05) {
+    const double top = std::min(scale_hi, feasibleScale(factor));
+    for (int i = 0; i < (mm_per_pixel ? 1 : kScaleSteps); ++i) {
+      const double scale = scale_lo * std::pow(scale_ratio, i);
+      if (!mm_per_pixel && scale > top) break;
+      tryGeometry({scale, factor}, default_sigma);
+    }
+  }
+  // Local pattern search around the best, halving the steps when nothing improves.
+  double scale_step = scale_ratio, factor_step = 0.025;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    const PressGeometry centre = best.geometry;
+    bool improved = false;
+    for (const double factor_move : {-1.0, 0.0, 1.0}) {
+      for (const double scale_move : {-1.0, 0.0, 1.0}) {
+        if (factor_move == 0.0 && scale_move == 0.0) continue;
+        if (mm_per_pixel && scale_move != 0.0) continue;
+        const PressGeometry g{centre.mm_per_pixel * std::pow(scale_step, scale_move),
+                              centre.radius_factor + factor_move * factor_step};
+        improved |= tryGeometry(g, default_sigma);
+      }
+    }
+    if (!improved) {
+      scale_step = std::sqrt(scale_step);
+      factor_step *= 0.5;
+    }
+  }
+  // The rim-shadow width, at the chosen geometry.
+  for (const double sigma : {0.15, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0}) tryGeometry(best.geometry, sigma);
+  return best;
+}
+
+}  // namespace norm2tex

@@ -1,0 +1,141 @@
+#include "norm2tex/render/digit_shader_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/common/error.hpp"
+
+namespace norm2tex {
+namespace {
+
+const char* const kFeatureNames[kShadingFeatureCount] = {
+    "slope_x", "slope_y", "slope_xx", "slope_xy", "slope_yy",
+    "depth",   "rim_out", "rim_in", "rim_right", "rim_left", "rim_down", "rim_up",
+    "slope_x*u", "slope_x*v", "slope_y*u", "slope_y*v",
+    "rim_right*u", "rim_right*v", "rim_left*u", "rim_left*v", "rim_down*u", "rim_down*v", "rim_up*u", "rim_up*v"};
+
+int blurRadiusPixels(double mm_per_pixel, double shadow_sigma_mm) {
+  return std::max(1, static_cast<int>(std::ceil(3.0 * shadow_sigma_mm / mm_per_pixel)));
+}
+
+}  // namespace
+
+std::string shadingFeatureNames() {
+  std::string names;
+  for (const char* name : kFeatureNames) names += (names.empty() ? "" : ", ") + std::string(name);
+  return names;
+}
+
+std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse() {
+  // Fitted by norm2tex_calibrate on digit_calibration_s09 (see config/digit.yaml, which holds
+  // the same numbers, and README "Calibrate your own DIGIT").
+  std::array<std::array<double, kShadingFeatureCount>, 3> response{};
+  return response;
+}
+
+int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm) {
+  // The blur spreads the deformation by its radius; the central differences of its slopes by
+  // one more pixel.
+  return blurRadiusPixels(mm_per_pixel, shadow_sigma_mm) + 2;
+}
+
+void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double shadow_sigma_mm,
+                            const cv::Rect& box, ShadingFeatureArray& features) {
+  if ((box & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows)) != box || box.empty()) {
+    throw Error("computeShadingFeatures: box outside the image");
+  }
+  for (cv::Mat1f& plane : features) plane.create(box.size());
+  const float inv_pixel = static_cast<float>(1.0 / mm_per_pixel);
+  const int last_row = gel_mm.rows - 1, last_col = gel_mm.cols - 1;
+  const float inv_half_cols = 2.0f / gel_mm.cols, inv_half_rows = 2.0f / gel_mm.rows;
+
+  // B = H blurred, over the box grown by one pixel for its differences (and by the kernel, so
+  // the blur inside sees the real neighbourhood); a copy, so the image border replicates.
+  const int radius = blurRadiusPixels(mm_per_pixel, shadow_sigma_mm);
+  cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
+                  box.height + 2 * radius + 2);
+  region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  cv::Mat1f blurred;
+  const double sigma_px = shadow_sigma_mm / mm_per_pixel;
+  cv::GaussianBlur(gel_mm(region).clone(), blurred, cv::Size(2 * radius + 1, 2 * radius + 1),
+                   sigma_px, sigma_px, cv::BORDER_REPLICATE);
+
+  for (int j = 0; j < box.height; ++j) {
+    const int r = box.y + j;
+    const int r0 = std::max(r - 1, 0), r1 = std::min(r + 1, last_row);
+    const float dy_scale = inv_pixel / static_cast<float>(r1 - r0);
+    const float* up = gel_mm.ptr<float>(r0);
+    const float* mid = gel_mm.ptr<float>(r);
+    const float* down = gel_mm.ptr<float>(r1);
+    const float* b_up = blurred.ptr<float>(r0 - region.y);
+    const float* b_mid = blurred.ptr<float>(r - region.y);
+    const float* b_down = blurred.ptr<float>(r1 - region.y);
+    float* out[kShadingFeatureCount];
+    for (int f = 0; f < kShadingFeatureCount; ++f) out[f] = features[f].ptr<float>(j);
+    for (int i = 0; i < box.width; ++i) {
+      const int c = box.x + i;
+      const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, last_col);
+      const float dx_scale = inv_pixel / static_cast<float>(c1 - c0);
+      const float gx = (mid[c1] - mid[c0]) * dx_scale;
+      const float gy = (down[c] - up[c]) * dy_scale;
+      const int bc = c - region.x, bc0 = c0 - region.x, bc1 = c1 - region.x;
+      out[0][i] = gx;
+      out[1][i] = gy;
+      out[2][i] = gx * gx;
+      out[3][i] = gx * gy;
+      out[4][i] = gy * gy;
+      out[5][i] = mid[c];
+      const float rim = b_mid[bc] - mid[c];
+      out[6][i] = std::max(rim, 0.0f);
+      out[7][i] = std::min(rim, 0.0f);
+      const float bx = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
+      const float by = (b_down[bc] - b_up[bc]) * dy_scale;
+      out[8][i] = std::max(bx, 0.0f);
+      out[9][i] = std::max(-bx, 0.0f);
+      out[10][i] = std::max(by, 0.0f);
+      out[11][i] = std::max(-by, 0.0f);
+      const float u = (c + 0.5f) * inv_half_cols - 1.0f, v = (r + 0.5f) * inv_half_rows - 1.0f;
+      out[12][i] = gx * u;
+      out[13][i] = gx * v;
+      out[14][i] = gy * u;
+      out[15][i] = gy * v;
+      for (int q = 0; q < 4; ++q) {
+        out[16 + 2 * q][i] = out[8 + q][i] * u;
+        out[17 + 2 * q][i] = out[8 + q][i] * v;
+      }
+    }
+  }
+}
+
+void applyShadingResponse(const ShadingFeatureArray& features, const ShadingOptions& shading,
+                          cv::Mat3f& diff) {
+  const cv::Size size = features[0].size();
+  diff.create(size);
+  float weight[3][kShadingFeatureCount];
+  for (int k = 0; k < 3; ++k) {
+    for (int f = 0; f < kShadingFeatureCount; ++f) {
+      weight[k][f] = static_cast<float>(shading.gain * shading.response_bgr[k][f]);
+    }
+  }
+  for (int r = 0; r < size.height; ++r) {
+    const float* in[kShadingFeatureCount];
+    for (int f = 0; f < kShadingFeatureCount; ++f) in[f] = features[f].ptr<float>(r);
+    float* out = diff.ptr<float>(r);
+    for (int c = 0; c < size.width; ++c) {
+      float b = 0.0f, g = 0.0f, red = 0.0f;
+      for (int f = 0; f < kShadingFeatureCount; ++f) {
+        const float value = in[f][c];
+        b += weight[0][f] * value;
+        g += weight[1][f] * value;
+        red += weight[2][f] * value;
+      }
+      out[3 * c] = b;
+      out[3 * c + 1] = g;
+      out[3 * c + 2] = red;
+    }
+  }
+}
+
+}  // namespace norm2tex
