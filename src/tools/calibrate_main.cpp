@@ -1,5 +1,7 @@
 // norm2tex_calibrate: fits a sensor yaml to your own DIGIT from no-contact frames and a few
 // ball presses (see norm2tex/calibrate/sensor_calibration.hpp for the method).
+#include <malloc.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -165,6 +167,11 @@ std::vector<std::optional<norm2tex::PressCircle>> loadLabels(
 }
 
 int run(int argc, char** argv) {
+  // The fit renders thousands of presses through frame-sized temporaries. glibc hands blocks
+  // over 128 KB straight back to the kernel, and on these VMs every fresh 4 KB page costs
+  // ~13 us to fault in again; keeping freed memory in the heap makes calibration ~3x faster.
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   std::vector<std::string> expanded = expandLists(argc, argv);
   std::vector<char*> pointers;
   for (std::string& argument : expanded) pointers.push_back(argument.data());
@@ -224,6 +231,13 @@ int run(int argc, char** argv) {
               seconds);
   for (const std::string& line : norm2tex::describeFitQuality(result)) {
     std::printf("  %s\n", line.c_str());
+  }
+  if (result.fit.scale_at_search_bound) {
+    std::fprintf(stderr,
+                 "norm2tex_calibrate: warning: the fitted scale (%.4f mm/px) is at the end of the "
+                 "searched range: the presses do not pin it down; measure it (a ruler pressed "
+                 "into the gel) and pass --mm-per-pixel\n",
+                 result.fit.geometry.mm_per_pixel);
   }
   return 0;
 }

@@ -35,10 +35,17 @@ cv::Mat1f simulatedPressGel(const SensorModel& base, const PressCircle& circle,
 /// its centre; far enough out to hold the rim shadow.
 constexpr double kFitRegionRadii = 2.0;
 
+/// The scales searched at QVGA (mm per pixel): a generous band around the 0.051-0.059 that
+/// four calibrations of real DIGITs measured.
+constexpr double kMinSearchedScale = 0.03;
+constexpr double kMaxSearchedScale = 0.1;
+
 /// A least-squares fit of the calibrated response to presses.
 struct ShadingFit {
   ShadingOptions shading;           ///< response fitted; gain 1; shadow_sigma_mm as used
   PressGeometry geometry;           ///< as used
+  GelOptions gel;                   ///< the gel smoothing used (base's; not fitted)
+  bool scale_at_search_bound = false;  ///< the fitted scale is an end of the searched range
   double variance_explained = 0.0;  ///< on the fitted presses, pixels of kFitRegionRadii
 };
 
@@ -49,9 +56,10 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
                               double shadow_sigma_mm);
 
 /// Fits the response and the geometry: the radius factor always, the scale when
-/// `mm_per_pixel` is not given, and the rim-shadow width; each chosen as the one whose fit
-/// explains the most variance (a coarse grid, then a local pattern search). Throws Error when
-/// no scale in the searched range (0.02-0.12 mm/px at QVGA, halved at VGA) fits the ball.
+/// `mm_per_pixel` is not given, and the rim-shadow width; each chosen as the one whose fit explains the most
+/// variance (a coarse grid, then a local pattern search). Throws Error when no scale in the
+/// searched range (kMinSearchedScale-kMaxSearchedScale mm/px at QVGA, halved at VGA) fits the
+/// ball.
 ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  const std::vector<PressObservation>& presses,
                                  double ball_radius_mm, std::optional<double> mm_per_pixel);

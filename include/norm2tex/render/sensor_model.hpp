@@ -34,7 +34,7 @@ struct ShadingOptions {
   /// norm2tex_calibrate on the MIT calibration set of one real DIGIT (see config/digit.yaml).
   std::array<std::array<double, kShadingFeatureCount>, 3> response_bgr{};
   /// Width (mm) of the blur whose spill past the contact rim carries the rim-shadow features.
-  double shadow_sigma_mm = 0.3;
+  double shadow_sigma_mm = 0.6;
 };
 
 /// Pixel noise added to a frame. A captured background already carries the sensor's noise, so

@@ -120,6 +120,7 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
 
   result.model = base;
   result.model.mm_per_pixel = result.fit.geometry.mm_per_pixel;
+  result.model.gel = result.fit.gel;
   result.model.shading = result.fit.shading;
   result.model.noise = measureBackgroundNoise([&] {
     std::vector<cv::Mat3b> frames;

@@ -41,7 +41,10 @@ void accumulate(const SensorModel& model, const PressObservation& press, const c
       cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius), cvCeil(2 * radius) + 2,
                cvCeil(2 * radius) + 2) &
       image;
-  double f[kF];
+  // Rows of features and targets of the region's pixels, then A += F^T F and B += F^T Y by
+  // matrix products (much faster than per-pixel rank-one updates).
+  cv::Mat1f f_rows(region.area(), kF, 0.0f), y_rows(region.area(), 3);
+  int n = 0;
   for (int r = region.y; r < region.y + region.height; ++r) {
     const cv::Vec3f* y_row = press.diff.ptr<cv::Vec3f>(r);
     for (int c = region.x; c < region.x + region.width; ++c) {
@@ -51,16 +54,24 @@ void accumulate(const SensorModel& model, const PressObservation& press, const c
       for (int k = 0; k < 3; ++k) {
         eq.yy[k] += y[k] * y[k];
         eq.y_sum[k] += y[k];
+        y_rows(n, k) = y[k];
       }
       eq.count += 1.0;
-      if (!box.contains(cv::Point(c, r))) continue;  // every feature is 0 there
-      for (int j = 0; j < kF; ++j) f[j] = features[j](r - box.y, c - box.x);
-      for (int i = 0; i < kF; ++i) {
-        if (f[i] == 0.0) continue;
-        for (int j = i; j < kF; ++j) eq.a(i, j) += f[i] * f[j];
-        for (int k = 0; k < 3; ++k) eq.b(i, k) += f[i] * y[k];
+      if (box.contains(cv::Point(c, r))) {  // every feature is 0 outside the box
+        float* f = f_rows.ptr<float>(n);
+        for (int j = 0; j < kF; ++j) f[j] = features[j](r - box.y, c - box.x);
       }
+      ++n;
     }
+  }
+  if (n == 0) return;
+  const cv::Mat1f f_used = f_rows.rowRange(0, n), y_used = y_rows.rowRange(0, n);
+  cv::Mat1f ata, aty;
+  cv::gemm(f_used, f_used, 1.0, cv::noArray(), 0.0, ata, cv::GEMM_1_T);
+  cv::gemm(f_used, y_used, 1.0, cv::noArray(), 0.0, aty, cv::GEMM_1_T);
+  for (int i = 0; i < kF; ++i) {
+    for (int j = i; j < kF; ++j) eq.a(i, j) += ata(i, j);
+    for (int k = 0; k < 3; ++k) eq.b(i, k) += aty(i, k);
   }
 }
 
@@ -121,7 +132,9 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
     const cv::Mat1f gel = simulatedPressGel(base, press.circle, geometry, ball_radius_mm);
     accumulate(model, press, gel, eq);
   }
-  return solve(eq, geometry, shadow_sigma_mm);
+  ShadingFit fit = solve(eq, geometry, shadow_sigma_mm);
+  fit.gel = base.gel;
+  return fit;
 }
 
 ShadingFit fitShadingAndGeometry(const SensorModel& base,
@@ -131,7 +144,7 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   double largest_radius_px = 0.0;
   for (const PressObservation& p : presses) largest_radius_px = std::max(largest_radius_px, p.circle.radius_px);
   const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
-  const double scale_lo = 0.02 * qvga, scale_hi = 0.12 * qvga;
+  const double scale_lo = kMinSearchedScale * qvga, scale_hi = kMaxSearchedScale * qvga;
   const double factor_lo = 0.8, factor_hi = 1.25;
   // Largest scale at which every contact (radius x factor) still fits the ball.
   const auto feasibleScale = [&](double factor) {
@@ -157,21 +170,22 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   const double default_sigma = makeDigitSensorModel().shading.shadow_sigma_mm;
   ShadingFit best;
   best.variance_explained = -1e300;
+  SensorModel model = base;
   const auto tryGeometry = [&](PressGeometry g, double sigma) {
     g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
     if (mm_per_pixel) g.mm_per_pixel = *mm_per_pixel;
     g.mm_per_pixel = std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
     if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) return false;
-    const ShadingFit fit = fitShadingResponse(base, presses, g, ball_radius_mm, sigma);
+    const ShadingFit fit = fitShadingResponse(model, presses, g, ball_radius_mm, sigma);
     if (fit.variance_explained <= best.variance_explained) return false;
     best = fit;
     return true;
   };
 
-  // Coarse grid: factor in steps of 0.05, scale log-spaced (14 steps over the range).
-  constexpr int kScaleSteps = 14;
+  // Coarse grid: factor in steps of 0.1, scale log-spaced (12 steps over the range).
+  constexpr int kScaleSteps = 12;
   const double scale_ratio = std::pow(scale_hi / scale_lo, 1.0 / (kScaleSteps - 1));
-  for (double factor = factor_lo; factor <= factor_hi + 1e-9; factor += 0.05) {
+  for (double factor = factor_lo; factor <= factor_hi + 1e-9; factor += 0.1) {
     const double top = std::min(scale_hi, feasibleScale(factor));
     for (int i = 0; i < (mm_per_pixel ? 1 : kScaleSteps); ++i) {
       const double scale = scale_lo * std::pow(scale_ratio, i);
@@ -180,7 +194,7 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
     }
   }
   // Local pattern search around the best, halving the steps when nothing improves.
-  double scale_step = scale_ratio, factor_step = 0.025;
+  double scale_step = scale_ratio, factor_step = 0.05;
   for (int iteration = 0; iteration < 10; ++iteration) {
     const PressGeometry centre = best.geometry;
     bool improved = false;
@@ -198,8 +212,33 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
       factor_step *= 0.5;
     }
   }
-  // The rim-shadow width, at the chosen geometry.
-  for (const double sigma : {0.15, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0}) tryGeometry(best.geometry, sigma);
+  // The rim-shadow width at the chosen geometry. (The gel's own smoothing is not fitted: a
+  // wider final blur fits these presses no better, and it would wash out Norm2Tex texture.)
+  for (const double sigma : {0.2, 0.3, 0.45, 0.6, 0.8, 1.0}) tryGeometry(best.geometry, sigma);
+  // And the geometry once more with it.
+  factor_step = 0.02;
+  scale_step = std::sqrt(std::sqrt(scale_ratio));
+  for (int iteration = 0; iteration < 6; ++iteration) {
+    const PressGeometry centre = best.geometry;
+    bool improved = false;
+    for (const double factor_move : {-1.0, 0.0, 1.0}) {
+      for (const double scale_move : {-1.0, 0.0, 1.0}) {
+        if ((factor_move == 0.0 && scale_move == 0.0) || (mm_per_pixel && scale_move != 0.0)) {
+          continue;
+        }
+        improved |= tryGeometry({centre.mm_per_pixel * std::pow(scale_step, scale_move),
+                                 centre.radius_factor + factor_move * factor_step},
+                                best.shading.shadow_sigma_mm);
+      }
+    }
+    if (!improved) {
+      scale_step = std::sqrt(scale_step);
+      factor_step *= 0.5;
+    }
+  }
+  const double s = best.geometry.mm_per_pixel;
+  best.scale_at_search_bound =
+      !mm_per_pixel && (s <= scale_lo * 1.01 || s >= 0.99 * std::min(scale_hi, feasibleScale(best.geometry.radius_factor)));
   return best;
 }
 

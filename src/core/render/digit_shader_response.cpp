@@ -16,8 +16,37 @@ const char* const kFeatureNames[kShadingFeatureCount] = {
     "slope_x*u", "slope_x*v", "slope_y*u", "slope_y*v",
     "rim_right*u", "rim_right*v", "rim_left*u", "rim_left*v", "rim_down*u", "rim_down*v", "rim_up*u", "rim_up*v"};
 
+
+// Gaussian blur of `field` with a wide sigma (pixels), replicating its border. Wide blurs run
+// on a copy reduced by a whole factor (sigma / kSigmaPerReducedPixel, area averaging) and are
+// upsampled bilinearly: the blurred field is smooth, so this costs no visible accuracy but cuts
+// the cost of a 0.6 mm blur at QVGA about 20-fold.
+constexpr double kSigmaPerReducedPixel = 2.5;
+
+int reductionFactor(double sigma_px) {
+  return std::max(1, static_cast<int>(sigma_px / kSigmaPerReducedPixel));
+}
+
+// How far the (reduced, truncated at 3 sigma, upsampled) blur spreads a value.
 int blurRadiusPixels(double mm_per_pixel, double shadow_sigma_mm) {
-  return std::max(1, static_cast<int>(std::ceil(3.0 * shadow_sigma_mm / mm_per_pixel)));
+  const double sigma_px = shadow_sigma_mm / mm_per_pixel;
+  return static_cast<int>(std::ceil(3.0 * sigma_px)) + 2 * reductionFactor(sigma_px);
+}
+cv::Mat1f blurWide(const cv::Mat1f& field, double sigma_px) {
+  const int factor = reductionFactor(sigma_px);
+  cv::Mat1f small = field.clone();
+  if (factor > 1) {
+    const cv::Size reduced(std::max(1, field.cols / factor), std::max(1, field.rows / factor));
+    cv::resize(field, small, reduced, 0, 0, cv::INTER_AREA);
+  }
+  const double sigma_small = sigma_px * small.cols / field.cols;
+  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_small)));
+  cv::GaussianBlur(small, small, cv::Size(2 * radius + 1, 2 * radius + 1), sigma_small,
+                   sigma_small, cv::BORDER_REPLICATE);
+  if (factor == 1) return small;
+  cv::Mat1f out;
+  cv::resize(small, out, field.size(), 0, 0, cv::INTER_LINEAR);
+  return out;
 }
 
 }  // namespace
@@ -31,8 +60,27 @@ std::string shadingFeatureNames() {
 std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse() {
   // Fitted by norm2tex_calibrate on digit_calibration_s09 (see config/digit.yaml, which holds
   // the same numbers, and README "Calibrate your own DIGIT").
-  std::array<std::array<double, kShadingFeatureCount>, 3> response{};
-  return response;
+  // Rows B, G, R; columns in the order of shadingFeatureNames().
+  return {{
+      {{ // blue
+       -3.6166, -26.2962, -23.5339, 19.5477, 25.0835, 1.1766,
+       -61.4783, -23.3168, -1.0589, 40.9249, -172.7516, 142.9430,
+       -7.3757, 42.1034, -16.4764, -15.1360, 30.5700, -46.4823,
+       -38.9442, -28.6223, 74.1642, -83.1572, -89.1423, 106.7472
+      }},
+      {{ // green
+       17.4984, -13.0831, 10.3890, 9.4435, -9.5117, -1.5107,
+       4.7807, -15.6215, 34.5059, -70.0997, 63.1788, -33.9835,
+       28.5503, -39.5099, 40.3749, -44.6347, 49.6234, -19.7042,
+       -12.6004, -38.2827, -28.8037, 107.4135, 45.2342, -85.6666
+      }},
+      {{ // red
+       -39.3929, 34.2037, 44.6670, -25.9116, -2.9154, 5.4930,
+       75.1308, -15.8227, -148.2101, 73.2994, 94.1257, -77.5468,
+       38.7029, 40.9097, -69.1293, -57.1095, 167.2225, 84.5907,
+       -131.6373, -86.4209, -24.2894, 138.3149, -26.1234, -98.0533
+      }}
+  }};
 }
 
 int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm) {
@@ -57,10 +105,7 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
   cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
                   box.height + 2 * radius + 2);
   region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
-  cv::Mat1f blurred;
-  const double sigma_px = shadow_sigma_mm / mm_per_pixel;
-  cv::GaussianBlur(gel_mm(region).clone(), blurred, cv::Size(2 * radius + 1, 2 * radius + 1),
-                   sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  const cv::Mat1f blurred = blurWide(gel_mm(region), shadow_sigma_mm / mm_per_pixel);
 
   for (int j = 0; j < box.height; ++j) {
     const int r = box.y + j;
