@@ -23,7 +23,7 @@ struct PressCircle {
 /// the border still gets its full circle. The threshold contour lies near the rim; the
 /// calibration fits one global factor on top of these radii, so a constant bias costs nothing.
 ///
-/// Throws Error naming `frame_name` when there is no press: a peak under 20 grey levels (sum of
+/// Throws Error naming `frame_name` when there is no press: a peak under 12 grey levels (sum of
 /// the three channels) above the baseline, a region under 30 pixels, or a contour too short
 /// to fit.
 PressCircle detectPress(const cv::Mat3f& diff, const std::string& frame_name);

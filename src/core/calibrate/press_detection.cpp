@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kBlurSigmaAtQvgaPx = 2.0;
 constexpr double kThresholdFraction = 0.25;
-constexpr double kMinPeakGreyLevels = 20.0;  // sum of |B| + |G| + |R| above the baseline
+constexpr double kMinPeakGreyLevels = 12.0;  // sum of |B| + |G| + |R| above the baseline
 constexpr int kMinRegionPixels = 30;
 constexpr int kMinContourPoints = 12;
 

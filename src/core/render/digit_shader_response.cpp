@@ -17,10 +17,12 @@ const char* const kFeatureNames[kShadingFeatureCount] = {
     "rim_right*u", "rim_right*v", "rim_left*u", "rim_left*v", "rim_down*u", "rim_down*v", "rim_up*u", "rim_up*v"};
 
 
-// Gaussian blur of `field` with a wide sigma (pixels), replicating its border. Wide blurs run
-// on a copy reduced by a whole factor (sigma / kSigmaPerReducedPixel, area averaging) and are
-// upsampled bilinearly: the blurred field is smooth, so this costs no visible accuracy but cuts
-// the cost of a 0.6 mm blur at QVGA about 20-fold.
+// Gaussian blur of gel_mm over `region` with a wide sigma (pixels), replicating the image
+// border. Wide blurs run on a copy reduced by a whole factor (sigma / kSigmaPerReducedPixel,
+// area averaging) and are upsampled bilinearly: the blurred field is smooth, so this costs no
+// visible accuracy but cuts the cost of a 0.6 mm blur at QVGA about 20-fold. The reduced grid
+// is aligned to multiples of the factor in image coordinates, so a pixel's value does not
+// depend on the region it was computed in (the shader's box or a whole frame).
 constexpr double kSigmaPerReducedPixel = 2.5;
 
 int reductionFactor(double sigma_px) {
@@ -32,21 +34,29 @@ int blurRadiusPixels(double mm_per_pixel, double shadow_sigma_mm) {
   const double sigma_px = shadow_sigma_mm / mm_per_pixel;
   return static_cast<int>(std::ceil(3.0 * sigma_px)) + 2 * reductionFactor(sigma_px);
 }
-cv::Mat1f blurWide(const cv::Mat1f& field, double sigma_px) {
+
+cv::Mat1f blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px) {
   const int factor = reductionFactor(sigma_px);
-  cv::Mat1f small = field.clone();
+  // The region snapped outwards to the reduced grid, padded by replication past the image.
+  const int x0 = region.x / factor * factor, y0 = region.y / factor * factor;
+  const int x1 = (region.x + region.width + factor - 1) / factor * factor;
+  const int y1 = (region.y + region.height + factor - 1) / factor * factor;
+  const cv::Rect inside = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  cv::Mat1f snapped;
+  cv::copyMakeBorder(gel_mm(inside), snapped, 0, y1 - y0 - inside.height, 0,
+                     x1 - x0 - inside.width, cv::BORDER_REPLICATE);
+  cv::Mat1f small = snapped;
   if (factor > 1) {
-    const cv::Size reduced(std::max(1, field.cols / factor), std::max(1, field.rows / factor));
-    cv::resize(field, small, reduced, 0, 0, cv::INTER_AREA);
+    cv::resize(snapped, small, cv::Size(snapped.cols / factor, snapped.rows / factor), 0, 0,
+               cv::INTER_AREA);
   }
-  const double sigma_small = sigma_px * small.cols / field.cols;
+  const double sigma_small = sigma_px / factor;
   const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_small)));
   cv::GaussianBlur(small, small, cv::Size(2 * radius + 1, 2 * radius + 1), sigma_small,
                    sigma_small, cv::BORDER_REPLICATE);
-  if (factor == 1) return small;
-  cv::Mat1f out;
-  cv::resize(small, out, field.size(), 0, 0, cv::INTER_LINEAR);
-  return out;
+  cv::Mat1f full = small;
+  if (factor > 1) cv::resize(small, full, snapped.size(), 0, 0, cv::INTER_LINEAR);
+  return full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).clone();
 }
 
 }  // namespace
@@ -105,7 +115,7 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
   cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
                   box.height + 2 * radius + 2);
   region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
-  const cv::Mat1f blurred = blurWide(gel_mm(region), shadow_sigma_mm / mm_per_pixel);
+  const cv::Mat1f blurred = blurWide(gel_mm, region, shadow_sigma_mm / mm_per_pixel);
 
   for (int j = 0; j < box.height; ++j) {
     const int r = box.y + j;
