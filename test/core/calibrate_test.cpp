@@ -4,6 +4,7 @@
 #include <malloc.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -12,7 +13,9 @@
 
 #include "norm2tex/calibrate/background_noise.hpp"
 #include "norm2tex/calibrate/ball_press.hpp"
+#include "norm2tex/calibrate/calibration_report.hpp"
 #include "norm2tex/calibrate/press_detection.hpp"
+#include "norm2tex/calibrate/press_refinement.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader.hpp"
@@ -61,17 +64,26 @@ cv::Mat3f difference(const cv::Mat3b& frame, const cv::Mat3b& background) {
   return f - b;
 }
 
-TEST(PressDetection, FindsTheCentreOfARenderedPress) {
+// Detection is the first estimate (centre within 0.2 mm, radius biased outwards by the rim
+// shadow and skirt); refinement against the model then recovers the true circle.
+TEST(PressDetection, FindsARenderedPressAndRefinementRecoversItsCircle) {
   const SensorModel m = makeDigitSensorModel();
   const cv::Mat3b background = makeSyntheticBackground(m.imageSize());
   const DigitShader shader(m, background, BackgroundSource::kSynthetic);
   for (const PressCircle& truth : spreadPresses(m, 6)) {
-    const PressCircle found =
-        detectPress(difference(renderPress(m, shader, truth, 3), background), "rendered");
-    EXPECT_LT(cv::norm(found.centre_px - truth.centre_px), 2.0) << truth.centre_px;
-    // The threshold contour lies near the rim (the fit scales all radii by one factor).
-    EXPECT_GT(found.radius_px, 0.7 * truth.radius_px);
-    EXPECT_LT(found.radius_px, 1.4 * truth.radius_px);
+    PressObservation press;
+    press.name = "rendered";
+    press.diff = difference(renderPress(m, shader, truth, 3), background);
+    press.circle = detectPress(press.diff, press.name);
+    EXPECT_LT(cv::norm(press.circle.centre_px - truth.centre_px), 0.2 / m.mm_per_pixel)
+        << truth.centre_px;
+    EXPECT_GT(press.circle.radius_px, 0.7 * truth.radius_px);
+    EXPECT_LT(press.circle.radius_px, 1.6 * truth.radius_px);
+    PressCircle start = press.circle;
+    start.radius_px /= 1.4;  // roughly the detector's bias (the fit finds it as a factor)
+    const PressCircle refined = refinePressCircle(shader, m, press, start, kBallRadiusMm);
+    EXPECT_LT(cv::norm(refined.centre_px - truth.centre_px), 0.5) << truth.centre_px;
+    EXPECT_NEAR(refined.radius_px, truth.radius_px, 0.03 * truth.radius_px) << truth.centre_px;
   }
 }
 
@@ -134,6 +146,8 @@ TEST(Calibration, RoundTripRecoversTheScaleAndReproducesHeldOutPresses) {
   SensorModel base = makeDigitSensorModel();
   base.mm_per_pixel = 0.08;  // not used: the scale is fitted
   const CalibrationResult result = calibrateSensor(base, input);
+  std::printf("round trip: scale %.4f mm/px (truth %.4f), held-out variance explained %.3f\n",
+              result.model.mm_per_pixel, truth.mm_per_pixel, result.held_out.variance_explained);
   EXPECT_NEAR(result.model.mm_per_pixel, truth.mm_per_pixel, 0.05 * truth.mm_per_pixel);
   EXPECT_GE(result.held_out.variance_explained, 0.95);
   EXPECT_GE(result.held_out.presses, 3);
@@ -161,6 +175,7 @@ TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
   options.holdout_fraction = 0.5;
   const CalibrationResult result = calibrateSensor(makeDigitSensorModel(), input, options);
   const FitQuality& q = result.held_out;
+  for (const std::string& line : describeFitQuality(result)) std::printf("%s\n", line.c_str());
   EXPECT_GE(q.presses, 7);
   EXPECT_GE(q.variance_explained, 0.5);
   for (int k = 0; k < 3; ++k) EXPECT_LE(q.side_error_deg[k], 30.0) << "channel " << k;

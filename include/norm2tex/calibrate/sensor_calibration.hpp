@@ -52,9 +52,11 @@ constexpr int kMinCalibrationPresses = 4;
 /// Calibrates a DIGIT: averages the backgrounds, finds each press's contact circle
 /// (detectPress, unless labelled), removes the frame's lighting drift (per channel, the median
 /// difference farther than 2.2 contact radii from the press), holds out every n-th press, fits
-/// geometry and shading on the rest (fitShadingAndGeometry), renders the held-out presses with
-/// DigitShader at the fitted geometry and compares (compareWithReal), and measures the
-/// background noise (measureBackgroundNoise). `base` gives the image size and the parts not
+/// geometry and shading on the rest (fitShadingAndGeometry), refines every unlabelled press's
+/// circle against that model (refinePressCircle: geometry only, so held-out presses stay
+/// unseen by the shading fit), refits, renders the held-out presses with DigitShader at the
+/// fitted geometry and compares (compareWithReal), and measures the background noise
+/// (measureBackgroundNoise). `base` gives the image size and the parts not
 /// fitted (gel smoothing, camera, LEDs). Throws Error naming the frame for frames of another
 /// size or orientation than `base`, presses it cannot find, a ball that cannot make the
 /// contacts, or fewer than kMinCalibrationPresses presses.

@@ -60,8 +60,10 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
 /// variance (a coarse grid, then a local pattern search). Throws Error when no scale in the
 /// searched range (kMinSearchedScale-kMaxSearchedScale mm/px at QVGA, halved at VGA) fits the
 /// ball.
+/// With `start`, the coarse grid is skipped and the local search starts there (a refit).
 ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  const std::vector<PressObservation>& presses,
-                                 double ball_radius_mm, std::optional<double> mm_per_pixel);
+                                 double ball_radius_mm, std::optional<double> mm_per_pixel,
+                                 std::optional<PressGeometry> start = std::nullopt);
 
 }  // namespace norm2tex

@@ -69,4 +69,11 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
 void applyShadingResponse(const ShadingFeatureArray& features, const ShadingOptions& shading,
                           cv::Mat3f& diff);
 
+/// The same as computeShadingFeatures then applyShadingResponse (equal up to float rounding),
+/// fused for the renderer: no feature planes; the position-dependent terms are folded into
+/// per-row coefficients a + b u, and four pixels run at once (SIMD). `diff` is box-sized.
+void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
+                              const ShadingOptions& shading, const cv::Rect& box,
+                              cv::Mat3f& diff);
+
 }  // namespace norm2tex

@@ -37,11 +37,9 @@ cv::Mat3b cropTile(const cv::Mat3b& image, cv::Point2d centre, double half) {
 std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
   const FitQuality& q = r.held_out;
   return {
-      format("scale %.4f mm/px (%.1f px/mm), radius factor %.3f, rim sigma %.2f mm, gel blur "
-             "%.2f mm",
+      format("scale %.4f mm/px (%.1f px/mm), rim shadow sigma %.2f mm",
              r.fit.geometry.mm_per_pixel, 1.0 / r.fit.geometry.mm_per_pixel,
-             r.fit.geometry.radius_factor, r.fit.shading.shadow_sigma_mm,
-             r.fit.gel.final_sigma_mm),
+             r.fit.shading.shadow_sigma_mm),
       format("fit on %.0f presses explains %.2f of their variance; %.0f held out:",
              r.training_presses, r.fit.variance_explained, q.presses),
       format("  variance explained %.2f", q.variance_explained),

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include "norm2tex/calibrate/background_noise.hpp"
+#include "norm2tex/calibrate/press_refinement.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader.hpp"
 
@@ -97,6 +99,7 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
 
   // Contact circles and drift-corrected differences.
   std::vector<PressObservation> training, held_out;
+  std::set<std::string> labelled;  // presses whose circle the user gave: never refined
   const int n = static_cast<int>(input.presses.size());
   const int held_out_count =
       std::clamp(static_cast<int>(std::lround(options.holdout_fraction * n)), 1, n - 3);
@@ -105,8 +108,9 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
     press.name = input.presses[i].name;
     input.presses[i].image.convertTo(press.diff, CV_32F);
     press.diff -= background;
-    const bool labelled = !input.labels.empty() && input.labels[i];
-    press.circle = labelled ? *input.labels[i] : detectPress(press.diff, press.name);
+    const bool has_label = !input.labels.empty() && input.labels[i];
+    press.circle = has_label ? *input.labels[i] : detectPress(press.diff, press.name);
+    if (has_label) labelled.insert(press.name);
     removeDrift(press);
     // Spread the held-out presses evenly over the set: press i is held out when the running
     // count floor((i + 1) k / n) steps up.
@@ -115,7 +119,27 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   }
 
   const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
-  result.fit = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
+  // A first fit on the detected circles, then every press's circle refined against it (labelled
+  // ones are kept), then the final fit.
+  const ShadingFit first = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
+  {
+    SensorModel model = base;
+    model.mm_per_pixel = first.geometry.mm_per_pixel;
+    model.shading = first.shading;
+    const DigitShader shader(model, cv::Mat3b(base.imageSize(), cv::Vec3b(0, 0, 0)),
+                             BackgroundSource::kCaptured);
+    for (std::vector<PressObservation>* set : {&training, &held_out}) {
+      for (PressObservation& press : *set) {
+        if (labelled.count(press.name)) continue;
+        PressCircle start = press.circle;
+        start.radius_px *= first.geometry.radius_factor;
+        press.circle = refinePressCircle(shader, model, press, start, ball_radius_mm);
+      }
+    }
+  }
+  // The refined circles carry the first radius factor: the refit starts from factor 1.
+  result.fit = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel,
+                                     PressGeometry{first.geometry.mm_per_pixel, 1.0});
   result.training_presses = static_cast<int>(training.size());
 
   result.model = base;

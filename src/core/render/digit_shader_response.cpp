@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
@@ -35,17 +37,23 @@ int blurRadiusPixels(double mm_per_pixel, double shadow_sigma_mm) {
   return static_cast<int>(std::ceil(3.0 * sigma_px)) + 2 * reductionFactor(sigma_px);
 }
 
-cv::Mat1f blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px) {
+// The per-frame path reuses these per thread (fresh pages cost ~13 us each on these VMs).
+struct BlurScratch {
+  cv::Mat1f snapped, small, full;
+};
+
+void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, cv::Mat1f& out) {
+  thread_local BlurScratch scratch;
   const int factor = reductionFactor(sigma_px);
   // The region snapped outwards to the reduced grid, padded by replication past the image.
   const int x0 = region.x / factor * factor, y0 = region.y / factor * factor;
   const int x1 = (region.x + region.width + factor - 1) / factor * factor;
   const int y1 = (region.y + region.height + factor - 1) / factor * factor;
   const cv::Rect inside = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
-  cv::Mat1f snapped;
+  cv::Mat1f& snapped = scratch.snapped;
   cv::copyMakeBorder(gel_mm(inside), snapped, 0, y1 - y0 - inside.height, 0,
                      x1 - x0 - inside.width, cv::BORDER_REPLICATE);
-  cv::Mat1f small = snapped;
+  cv::Mat1f& small = factor > 1 ? scratch.small : snapped;
   if (factor > 1) {
     cv::resize(snapped, small, cv::Size(snapped.cols / factor, snapped.rows / factor), 0, 0,
                cv::INTER_AREA);
@@ -54,9 +62,9 @@ cv::Mat1f blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma
   const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_small)));
   cv::GaussianBlur(small, small, cv::Size(2 * radius + 1, 2 * radius + 1), sigma_small,
                    sigma_small, cv::BORDER_REPLICATE);
-  cv::Mat1f full = small;
+  cv::Mat1f& full = factor > 1 ? scratch.full : small;
   if (factor > 1) cv::resize(small, full, snapped.size(), 0, 0, cv::INTER_LINEAR);
-  return full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).clone();
+  full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).copyTo(out);
 }
 
 }  // namespace
@@ -73,22 +81,22 @@ std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse()
   // Rows B, G, R; columns in the order of shadingFeatureNames().
   return {{
       {{ // blue
-       -3.6166, -26.2962, -23.5339, 19.5477, 25.0835, 1.1766,
-       -61.4783, -23.3168, -1.0589, 40.9249, -172.7516, 142.9430,
-       -7.3757, 42.1034, -16.4764, -15.1360, 30.5700, -46.4823,
-       -38.9442, -28.6223, 74.1642, -83.1572, -89.1423, 106.7472
+       -1.7029, -27.0042, -22.5671, 8.1038, 50.1430, 1.2310,
+       -14.0443, -29.4138, -3.9875, 49.1282, -195.7080, 136.3275,
+       -10.2096, 39.5105, -24.7101, -33.8021, 31.6150, -23.9993,
+       -56.9498, -28.5463, 74.1623, -68.9803, -81.8773, 74.9964
       }},
       {{ // green
-       17.4984, -13.0831, 10.3890, 9.4435, -9.5117, -1.5107,
-       4.7807, -15.6215, 34.5059, -70.0997, 63.1788, -33.9835,
-       28.5503, -39.5099, 40.3749, -44.6347, 49.6234, -19.7042,
-       -12.6004, -38.2827, -28.8037, 107.4135, 45.2342, -85.6666
+       22.7729, -14.1977, 6.5536, 11.9932, -11.0092, -1.8850,
+       4.3925, -8.6974, 34.8648, -56.6451, 60.3049, -34.5307,
+       31.0407, -24.5424, 42.9954, -46.6421, 71.4478, -53.8582,
+       -25.5489, -13.7633, -21.3278, 109.7863, 33.0463, -88.1230
       }},
       {{ // red
-       -39.3929, 34.2037, 44.6670, -25.9116, -2.9154, 5.4930,
-       75.1308, -15.8227, -148.2101, 73.2994, 94.1257, -77.5468,
-       38.7029, 40.9097, -69.1293, -57.1095, 167.2225, 84.5907,
-       -131.6373, -86.4209, -24.2894, 138.3149, -26.1234, -98.0533
+       -40.9611, 28.8587, 10.4038, -19.5692, -25.0703, 17.6520,
+       -7.5369, 51.8362, -126.7547, 102.7007, 114.6011, -98.8973,
+       57.8865, 41.4779, -60.4570, -36.5937, 134.7587, 109.4196,
+       -140.2055, -132.1345, -36.4502, 113.7772, 22.2459, -70.8375
       }}
   }};
 }
@@ -115,7 +123,8 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
   cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
                   box.height + 2 * radius + 2);
   region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
-  const cv::Mat1f blurred = blurWide(gel_mm, region, shadow_sigma_mm / mm_per_pixel);
+  cv::Mat1f blurred;
+  blurWide(gel_mm, region, shadow_sigma_mm / mm_per_pixel, blurred);
 
   for (int j = 0; j < box.height; ++j) {
     const int r = box.y + j;
@@ -161,6 +170,110 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
         out[17 + 2 * q][i] = out[8 + q][i] * v;
       }
     }
+  }
+}
+
+void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
+                              const ShadingOptions& shading, const cv::Rect& box,
+                              cv::Mat3f& diff) {
+  if ((box & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows)) != box || box.empty()) {
+    throw Error("computeShadingDifference: box outside the image");
+  }
+  diff.create(box.size());
+  const float inv_pixel = static_cast<float>(1.0 / mm_per_pixel);
+  const int last_row = gel_mm.rows - 1, last_col = gel_mm.cols - 1;
+  const float inv_half_cols = 2.0f / gel_mm.cols, inv_half_rows = 2.0f / gel_mm.rows;
+  const double sigma_mm = shading.shadow_sigma_mm;
+  const int radius = blurRadiusPixels(mm_per_pixel, sigma_mm);
+  cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
+                  box.height + 2 * radius + 2);
+  region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  thread_local cv::Mat1f blurred;
+  blurWide(gel_mm, region, sigma_mm / mm_per_pixel, blurred);
+
+  float w[3][kShadingFeatureCount];
+  for (int k = 0; k < 3; ++k) {
+    for (int f = 0; f < kShadingFeatureCount; ++f) {
+      w[k][f] = static_cast<float>(shading.gain * shading.response_bgr[k][f]);
+    }
+  }
+  // Base features whose coefficient varies with the position: slope_x, slope_y, rim_right,
+  // rim_left, rim_down, rim_up, with their u- and v-terms.
+  constexpr int kVarying = 6;
+  const int base[kVarying] = {0, 1, 8, 9, 10, 11};
+  const int u_term[kVarying] = {12, 14, 16, 18, 20, 22};
+
+  constexpr int kLanes = 4;
+  const int width = box.width;
+  const int padded = (width + kLanes - 1) / kLanes * kLanes;
+  // Row buffers, padded so that the last SIMD step may read past the box; reused per thread.
+  thread_local std::vector<float> rows_scratch;
+  rows_scratch.assign(9 * padded, 0.0f);
+  float* gx = rows_scratch.data();
+  float* gy = gx + padded;
+  float* hh = gy + padded;
+  float* rim = hh + padded;
+  float* bx = rim + padded;
+  float* by = bx + padded;
+  float* out = by + padded;
+  using cv::v_float32x4;
+  const v_float32x4 zero = cv::v_setzero_f32();
+  const v_float32x4 lane_u(0.0f, inv_half_cols, 2.0f * inv_half_cols, 3.0f * inv_half_cols);
+
+  for (int j = 0; j < box.height; ++j) {
+    const int r = box.y + j;
+    const int r0 = std::max(r - 1, 0), r1 = std::min(r + 1, last_row);
+    const float dy_scale = inv_pixel / static_cast<float>(r1 - r0);
+    const float* up = gel_mm.ptr<float>(r0);
+    const float* mid = gel_mm.ptr<float>(r);
+    const float* down = gel_mm.ptr<float>(r1);
+    const float* b_up = blurred.ptr<float>(r0 - region.y);
+    const float* b_mid = blurred.ptr<float>(r - region.y);
+    const float* b_down = blurred.ptr<float>(r1 - region.y);
+    for (int i = 0; i < width; ++i) {
+      const int c = box.x + i;
+      const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, last_col);
+      const float dx_scale = inv_pixel / static_cast<float>(c1 - c0);
+      const int bc = c - region.x, bc0 = c0 - region.x, bc1 = c1 - region.x;
+      gx[i] = (mid[c1] - mid[c0]) * dx_scale;
+      gy[i] = (down[c] - up[c]) * dy_scale;
+      hh[i] = mid[c];
+      rim[i] = b_mid[bc] - mid[c];
+      bx[i] = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
+      by[i] = (b_down[bc] - b_up[bc]) * dy_scale;
+    }
+    // Per row and channel: coefficient of a varying feature = a + b u, a = w + w_v v.
+    const float v = (r + 0.5f) * inv_half_rows - 1.0f;
+    v_float32x4 a[3][kVarying], b[3][kVarying], fixed[3][6];
+    for (int k = 0; k < 3; ++k) {
+      for (int q = 0; q < kVarying; ++q) {
+        a[k][q] = cv::v_setall_f32(w[k][base[q]] + w[k][u_term[q] + 1] * v);
+        b[k][q] = cv::v_setall_f32(w[k][u_term[q]]);
+      }
+      for (int q = 0; q < 6; ++q) fixed[k][q] = cv::v_setall_f32(w[k][2 + q]);  // features 2-7
+    }
+    for (int i = 0; i < padded; i += kLanes) {
+      const v_float32x4 u =
+          cv::v_setall_f32((box.x + i + 0.5f) * inv_half_cols - 1.0f) + lane_u;
+      const v_float32x4 x = cv::v_load(&gx[i]), y = cv::v_load(&gy[i]);
+      const v_float32x4 rim_v = cv::v_load(&rim[i]);
+      const v_float32x4 bxv = cv::v_load(&bx[i]), byv = cv::v_load(&by[i]);
+      const v_float32x4 varying[kVarying] = {x, y, cv::v_max(bxv, zero), cv::v_max(zero - bxv, zero),
+                                             cv::v_max(byv, zero), cv::v_max(zero - byv, zero)};
+      const v_float32x4 constant[6] = {x * x, x * y, y * y, cv::v_load(&hh[i]),
+                                       cv::v_max(rim_v, zero), cv::v_min(rim_v, zero)};
+      v_float32x4 channel[3];
+      for (int k = 0; k < 3; ++k) {
+        v_float32x4 acc = zero;
+        for (int q = 0; q < 6; ++q) acc = cv::v_fma(fixed[k][q], constant[q], acc);
+        for (int q = 0; q < kVarying; ++q) {
+          acc = cv::v_fma(cv::v_fma(b[k][q], u, a[k][q]), varying[q], acc);
+        }
+        channel[k] = acc;
+      }
+      cv::v_store_interleave(&out[3 * i], channel[0], channel[1], channel[2]);
+    }
+    std::copy_n(out, 3 * width, diff.ptr<float>(j));
   }
 }
 
