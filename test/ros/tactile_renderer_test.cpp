@@ -21,10 +21,16 @@
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
+#include "norm2tex/render/digit_shader_response.hpp"
+#include "norm2tex/render/sensor_model.hpp"
 #include "run_node.hpp"
 #include "wait_for.hpp"
 
 namespace {
+
+// The sensor the sync rostests launch (tactile_renderer_sync.test).
+const char* const kSensorYaml = NORM2TEX_SOURCE_DIR "/config/digit.yaml";
+
 
 using norm2tex::waitFor;
 
@@ -287,9 +293,16 @@ TEST(SynchronousRendering, MaterialChangesTextureNotContactAndBetaZeroIsTexturel
   const cv::Scalar inside = cv::mean(diff, mask("digit_left"));
   EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 1.0);
   // ... and the very same pixels far from it (beyond the gel's skirt).
+  // Beyond the gel's skirt (3 sigma of its smoothing pyramid) and the shading's reach (its
+  // rim-shadow blur), in pixels of the shipped sensor.
+  const norm2tex::SensorModel sensor = norm2tex::loadSensorModel(kSensorYaml);
+  double variance_mm2 = 0.0;
+  for (const double sigma : sensor.gel.pyramid_sigmas_mm) variance_mm2 += sigma * sigma;
+  const int far_px =
+      static_cast<int>(std::ceil(3.0 * std::sqrt(variance_mm2) / sensor.mm_per_pixel)) +
+      norm2tex::shadingReachPixels(sensor.mm_per_pixel, sensor.shading.shadow_sigma_mm) + 8;
   cv::Mat near;
-  cv::dilate(mask("digit_left"), near, cv::Mat(), cv::Point(-1, -1),
-             80);  // 6 x the gel's 1 mm blur
+  cv::dilate(mask("digit_left"), near, cv::Mat(), cv::Point(-1, -1), far_px);
   cv::Mat far;
   cv::bitwise_not(near, far);
   ASSERT_GT(cv::countNonZero(far), 1000);
@@ -302,7 +315,9 @@ TEST(SynchronousRendering, MaterialChangesTextureNotContactAndBetaZeroIsTexturel
 TEST(SynchronousRendering, AOneMillimetreSlideShiftsTheTextureByOneMillimetre) {
   SyncFixture f;
   ASSERT_TRUE(f.ready());
-  // The cube 1 mm higher = 1 mm towards the image top: 1 / 0.08 = 12.5 pixels.
+  // The cube 1 mm higher = 1 mm towards the image top: 1 / mm_per_pixel pixels of the shipped
+  // sensor (18.8 at its 0.0532 mm/px).
+  const double pixels_per_mm = 1.0 / norm2tex::loadSensorModel(kSensorYaml).mm_per_pixel;
   std::vector<cv::Mat> crops;
   for (double offset : {0.000, 0.001}) {
     norm2tex::Reset episode;
@@ -320,7 +335,7 @@ TEST(SynchronousRendering, AOneMillimetreSlideShiftsTheTextureByOneMillimetre) {
     crops.push_back(relief(cv::Rect(40, 60, 160, 160)).clone());
   }
   const cv::Point2d shift = cv::phaseCorrelate(crops[0], crops[1]);
-  EXPECT_NEAR(shift.y, -12.5, 0.5);
+  EXPECT_NEAR(shift.y, -pixels_per_mm, 0.5);
   EXPECT_NEAR(shift.x, 0.0, 0.5);
 }
 
