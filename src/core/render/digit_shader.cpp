@@ -256,11 +256,10 @@ cv::Mat3b DigitShader::shade(const cv::Mat1f& h_final_mm, std::int64_t noise_see
   cv::Mat3b image;
   background_.copyTo(image);
   if (noise_seed < 0 || !addsNoise()) {
-    for (int r = box.y; r < box.y + box.height; ++r) {
-      const uchar* bg = background_.ptr<uchar>(r) + 3 * box.x;
-      uchar* out = image.ptr<uchar>(r) + 3 * box.x;
-      const float* d = diff.ptr<float>(r - box.y);
-      for (int k = 0; k < 3 * box.width; ++k) out[k] = cv::saturate_cast<uchar>(bg[k] + d[k]);
+    // background + diff, rounded and saturated (OpenCV's vectorised mixed-type add).
+    if (!box.empty()) {
+      cv::Mat out = image(box);
+      cv::add(background_(box), diff, out, cv::noArray(), CV_8U);
     }
     return image;
   }
@@ -269,12 +268,7 @@ cv::Mat3b DigitShader::shade(const cv::Mat1f& h_final_mm, std::int64_t noise_see
   thread_local cv::Mat3f noise;  // reused per thread, like diff_scratch
   noise_.generate(image.size(), static_cast<std::uint64_t>(noise_seed), noise);
   if (!box.empty()) noise(box) += diff;
-  for (int r = 0; r < image.rows; ++r) {
-    const uchar* bg = background_.ptr<uchar>(r);
-    const float* n = noise.ptr<float>(r);
-    uchar* out = image.ptr<uchar>(r);
-    for (int k = 0; k < 3 * image.cols; ++k) out[k] = cv::saturate_cast<uchar>(bg[k] + n[k]);
-  }
+  cv::add(background_, noise, image, cv::noArray(), CV_8U);
   return image;
 }
 

@@ -230,7 +230,27 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
     const float* b_up = blurred.ptr<float>(r0 - region.y);
     const float* b_mid = blurred.ptr<float>(r - region.y);
     const float* b_down = blurred.ptr<float>(r1 - region.y);
-    for (int i = 0; i < width; ++i) {
+    // Interior columns without clamping (so the compiler vectorises them); the image's first
+    // and last columns take one-sided differences.
+    const float half_inv_pixel = 0.5f * inv_pixel;
+    const float* h_row = mid + box.x;
+    const float* h_up = up + box.x;
+    const float* h_down = down + box.x;
+    const float* b_row = b_mid + (box.x - region.x);
+    const float* b_row_up = b_up + (box.x - region.x);
+    const float* b_row_down = b_down + (box.x - region.x);
+    const int first = box.x == 0 ? 1 : 0;
+    const int last = box.x + width - 1 == last_col ? width - 1 : width;
+    for (int i = first; i < last; ++i) {
+      gx[i] = (h_row[i + 1] - h_row[i - 1]) * half_inv_pixel;
+      gy[i] = (h_down[i] - h_up[i]) * dy_scale;
+      hh[i] = h_row[i];
+      rim[i] = b_row[i] - h_row[i];
+      bx[i] = (b_row[i + 1] - b_row[i - 1]) * half_inv_pixel;
+      by[i] = (b_row_down[i] - b_row_up[i]) * dy_scale;
+    }
+    for (const int i : {0, width - 1}) {
+      if (i >= first && i < last) continue;
       const int c = box.x + i;
       const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, last_col);
       const float dx_scale = inv_pixel / static_cast<float>(c1 - c0);
@@ -256,13 +276,27 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
       const v_float32x4 u =
           cv::v_setall_f32((box.x + i + 0.5f) * inv_half_cols - 1.0f) + lane_u;
       const v_float32x4 x = cv::v_load(&gx[i]), y = cv::v_load(&gy[i]);
+      const v_float32x4 depth = cv::v_load(&hh[i]);
       const v_float32x4 rim_v = cv::v_load(&rim[i]);
       const v_float32x4 bxv = cv::v_load(&bx[i]), byv = cv::v_load(&by[i]);
       const v_float32x4 varying[kVarying] = {x, y, cv::v_max(bxv, zero), cv::v_max(zero - bxv, zero),
                                              cv::v_max(byv, zero), cv::v_max(zero - byv, zero)};
-      const v_float32x4 constant[6] = {x * x, x * y, y * y, cv::v_load(&hh[i]),
-                                       cv::v_max(rim_v, zero), cv::v_min(rim_v, zero)};
+      const v_float32x4 constant[6] = {x * x, x * y, y * y, depth, cv::v_max(rim_v, zero),
+                                       cv::v_min(rim_v, zero)};
       v_float32x4 channel[3];
+      if (cv::v_check_all((x == zero) & (y == zero) & (depth == zero))) {
+        // Outside the deformation (most of the box: the rim shadow's reach) only the rim terms
+        // are non-zero; the same sums in the same order, without the zero terms.
+        for (int k = 0; k < 3; ++k) {
+          v_float32x4 acc = cv::v_fma(fixed[k][5], constant[5], fixed[k][4] * constant[4]);
+          for (int q = 2; q < kVarying; ++q) {
+            acc = cv::v_fma(cv::v_fma(b[k][q], u, a[k][q]), varying[q], acc);
+          }
+          channel[k] = acc;
+        }
+        cv::v_store_interleave(&out[3 * i], channel[0], channel[1], channel[2]);
+        continue;
+      }
       for (int k = 0; k < 3; ++k) {
         v_float32x4 acc = zero;
         for (int q = 0; q < 6; ++q) acc = cv::v_fma(fixed[k][q], constant[q], acc);
