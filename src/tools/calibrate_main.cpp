@@ -89,7 +89,8 @@ norm2tex::NamedFrame loadFrame(const std::string& path, const std::optional<cv::
       throw Error("frame '" + path + "' is " + std::to_string(image.cols) + " x " +
                   std::to_string(image.rows) + (portrait ? " (portrait)" : " (landscape)") +
                   " but --size asks for " + std::to_string(size->width) + " x " +
-                  std::to_string(size->height) + "; rotate it the way your driver publishes frames");
+                  std::to_string(size->height) +
+                  "; rotate it the way your driver publishes frames");
     }
     cv::resize(image, image, *size, 0, 0, cv::INTER_AREA);
   }

@@ -37,8 +37,8 @@ const bool kHeapTuned = [] {
 }();
 
 // A press frame rendered by `truth`: a ball of kBallRadiusMm whose contact is `circle`.
-cv::Mat3b renderPress(const SensorModel& truth, const DigitShader& shader, const PressCircle& circle,
-                      std::int64_t seed) {
+cv::Mat3b renderPress(const SensorModel& truth, const DigitShader& shader,
+                      const PressCircle& circle, std::int64_t seed) {
   cv::Mat1f gel;
   GelModel(truth).apply(ballPressIndentation(truth, circle, kBallRadiusMm), gel);
   return shader.shade(gel, seed);
@@ -51,8 +51,9 @@ std::vector<PressCircle> spreadPresses(const SensorModel& m, int count) {
   for (int i = 0; i < count; ++i) {
     const double radius_mm = 1.1 + 0.7 * (i % 5) / 4.0;
     const double x = rng.uniform(-4.0, 4.0), y = rng.uniform(-6.0, 6.0);
-    circles.push_back({{x / m.mm_per_pixel + 0.5 * m.cols - 0.5, y / m.mm_per_pixel + 0.5 * m.rows - 0.5},
-                       radius_mm / m.mm_per_pixel});
+    circles.push_back(
+        {{x / m.mm_per_pixel + 0.5 * m.cols - 0.5, y / m.mm_per_pixel + 0.5 * m.rows - 0.5},
+         radius_mm / m.mm_per_pixel});
   }
   return circles;
 }
@@ -139,7 +140,8 @@ TEST(Calibration, RoundTripRecoversTheScaleAndReproducesHeldOutPresses) {
   input.backgrounds.push_back({"bg1", shader.shade(flat, 101)});
   int seed = 0;
   for (const PressCircle& circle : spreadPresses(truth, 14)) {
-    input.presses.push_back({"press" + std::to_string(seed), renderPress(truth, shader, circle, seed)});
+    input.presses.push_back(
+        {"press" + std::to_string(seed), renderPress(truth, shader, circle, seed)});
     ++seed;
   }
   input.ball_diameter_mm = 2.0 * kBallRadiusMm;
@@ -197,7 +199,8 @@ TEST(Calibration, BadInputIsAClearError) {
   good.backgrounds.push_back({"bg.png", smooth});
   int seed = 0;
   for (const PressCircle& circle : spreadPresses(m, 5)) {
-    good.presses.push_back({"p" + std::to_string(seed) + ".png", renderPress(m, shader, circle, seed)});
+    good.presses.push_back(
+        {"p" + std::to_string(seed) + ".png", renderPress(m, shader, circle, seed)});
     ++seed;
   }
   good.ball_diameter_mm = 6.0;

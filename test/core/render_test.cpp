@@ -159,8 +159,9 @@ TEST_F(RenderTest, TextureChangesTheImageOnlyAroundTheContact) {
   double variance_mm2 = 0.0;
   for (const double sigma : model_.gel.pyramid_sigmas_mm) variance_mm2 += sigma * sigma;
   cv::Mat1b near;
-  const int grow = static_cast<int>(std::ceil(3.0 * std::sqrt(variance_mm2) / model_.mm_per_pixel)) +
-                   renderer_.shader().reachPixels();
+  const int grow =
+      static_cast<int>(std::ceil(3.0 * std::sqrt(variance_mm2) / model_.mm_per_pixel)) +
+      renderer_.shader().reachPixels();
   cv::dilate(plain_contact, near,
              cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * grow + 1, 2 * grow + 1}));
   EXPECT_EQ(cv::countNonZero(changed & ~near), 0);

@@ -60,6 +60,7 @@ TEST(SensorModel, SavedModelLoadsBackTheSame) {
   m.noise.sigma_bgr = {3.0, 1.25, 2.0};
   m.noise.correlation_gr = -0.3;
   m.gel.pyramid_sigmas_mm = {0.6, 0.2};
+  m.gel_pad_width_mm = 18.35;
   m.background_image = "bg.png";
   saveSensorModel(m, dir.path("saved.yaml"));
   const SensorModel loaded = loadSensorModel(dir.path("saved.yaml"));
@@ -70,6 +71,7 @@ TEST(SensorModel, SavedModelLoadsBackTheSame) {
   EXPECT_EQ(loaded.noise.sigma_bgr, m.noise.sigma_bgr);
   EXPECT_DOUBLE_EQ(loaded.noise.correlation_gr, -0.3);
   EXPECT_EQ(loaded.gel.pyramid_sigmas_mm, m.gel.pyramid_sigmas_mm);
+  EXPECT_DOUBLE_EQ(loaded.gel_pad_width_mm, 18.35);
   EXPECT_EQ(loaded.leds[1].position_mm, m.leds[1].position_mm);
   EXPECT_EQ(loaded.background_image, dir.path("bg.png")) << "relative to the yaml";
 }

@@ -142,7 +142,8 @@ TEST_F(ShaderTest, NoiseHasTheMeasuredPerChannelSigmaAndCorrelations) {
           << "channel " << k << " scale " << scale;
       EXPECT_NEAR(cv::mean(planes[k])[0], 0.0, 0.05 * sigma);
       const cv::Rect left(0, 0, planes[k].cols - 1, planes[k].rows);
-      const cv::Mat1f a = planes[k](left).clone(), right = planes[k](left + cv::Point(1, 0)).clone();
+      const cv::Mat1f a = planes[k](left).clone(),
+                      right = planes[k](left + cv::Point(1, 0)).clone();
       if (scale > 1.0) {  // at sigma 1.5 the rounding to grey levels dilutes the correlation
         EXPECT_NEAR(test::correlation(a, right, cv::Mat1b(a.size(), 255)), 0.6, 0.05) << k;
       }
@@ -366,17 +367,17 @@ TEST(ShaderResponseTest, FeaturesOfAParaboloidMatchItsDerivatives) {
       const cv::Point2d p = model.pixelToGelMm(r, c);
       const auto at = [&](int j) { return static_cast<double>(f[j](r, c)); };
       const double gx = -2 * b * p.x, gy = -2 * b * p.y;
-      const double u = (c + 0.5) / (0.5 * model.cols) - 1.0, v = (r + 0.5) / (0.5 * model.rows) - 1.0;
-      worst_slope = std::max({worst_slope, std::abs(at(0) - gx), std::abs(at(1) - gy),
-                              std::abs(at(2) - gx * gx), std::abs(at(3) - gx * gy),
-                              std::abs(at(4) - gy * gy), std::abs(at(5) - static_cast<double>(h(r, c))),
-                              std::abs(at(12) - gx * u), std::abs(at(15) - gy * v)});
-      worst_rim = std::max({worst_rim, std::abs(at(7) + 2 * b * sigma * sigma),
-                            std::abs(at(6))});
+      const double u = (c + 0.5) / (0.5 * model.cols) - 1.0,
+                   v = (r + 0.5) / (0.5 * model.rows) - 1.0;
+      worst_slope =
+          std::max({worst_slope, std::abs(at(0) - gx), std::abs(at(1) - gy),
+                    std::abs(at(2) - gx * gx), std::abs(at(3) - gx * gy), std::abs(at(4) - gy * gy),
+                    std::abs(at(5) - static_cast<double>(h(r, c))), std::abs(at(12) - gx * u),
+                    std::abs(at(15) - gy * v)});
+      worst_rim = std::max({worst_rim, std::abs(at(7) + 2 * b * sigma * sigma), std::abs(at(6))});
       // rim_right - rim_left = dB/dx, rim_down - rim_up = dB/dy.
       worst_blur_slope = std::max({worst_blur_slope, std::abs(at(8) - at(9) - gx),
-                                   std::abs(at(10) - at(11) - gy),
-                                   std::abs(at(16) - at(8) * u)});
+                                   std::abs(at(10) - at(11) - gy), std::abs(at(16) - at(8) * u)});
     }
   }
   EXPECT_LT(worst_slope, 1e-4);
@@ -399,7 +400,8 @@ TEST(ShaderResponseTest, ShaderAppliesTheResponseToTheFeatures) {
     const cv::Mat3f diff = DigitShader(model, background, kSynthetic).shadingDifference(h);
     std::vector<cv::Mat1f> planes;
     cv::split(diff, planes);
-    EXPECT_LT(cv::norm(planes[2], f[feature], cv::NORM_INF), 1e-4 * cv::norm(f[feature], cv::NORM_INF))
+    EXPECT_LT(cv::norm(planes[2], f[feature], cv::NORM_INF),
+              1e-4 * cv::norm(f[feature], cv::NORM_INF))
         << feature;
     EXPECT_GT(cv::norm(f[feature], cv::NORM_INF), 1e-3) << feature;
     EXPECT_EQ(cv::norm(planes[0], cv::NORM_INF) + cv::norm(planes[1], cv::NORM_INF), 0.0);
@@ -429,8 +431,8 @@ TEST(ShaderResponseTest, CalibratedBallPressLooksLikeARealOne) {
     // compareWithReal's measures of the press itself (against an all-zero "simulation").
     const FitQuality q = compareWithReal({press}, {cv::Mat3f(press.diff.size(), cv::Vec3f())},
                                          {press.circle.radius_px});
-    const std::string where = "centre " + std::to_string(centre_mm.x) + ", " +
-                              std::to_string(centre_mm.y) + " mm";
+    const std::string where =
+        "centre " + std::to_string(centre_mm.x) + ", " + std::to_string(centre_mm.y) + " mm";
     EXPECT_NEAR(q.real_side_deg[0], 70.0, 14.0 + 15.0) << "blue, " << where;
     EXPECT_NEAR(q.real_side_deg[1], -154.0, 9.0 + 15.0) << "green, " << where;
     EXPECT_NEAR(q.real_side_deg[2], -41.0, 11.0 + 15.0) << "red, " << where;

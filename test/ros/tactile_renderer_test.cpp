@@ -31,7 +31,6 @@ namespace {
 // The sensor the sync rostests launch (tactile_renderer_sync.test).
 const char* const kSensorYaml = NORM2TEX_SOURCE_DIR "/config/digit.yaml";
 
-
 using norm2tex::waitFor;
 
 cv::Mat view(const sensor_msgs::Image& msg) {

@@ -96,8 +96,8 @@ TEST_F(CalibrateCli, LabelsReplaceDetection) {
   EXPECT_NO_THROW(norm2tex::loadSensorModel(path("labelled.yaml")));
   std::ofstream(path("bad_labels.csv")) << "press0.png,10,20\n";
   const CliRun bad = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
-                               " --ball-diameter-mm 6 --labels " + path("bad_labels.csv") +
-                               " -o " + path("x.yaml"));
+                               " --ball-diameter-mm 6 --labels " + path("bad_labels.csv") + " -o " +
+                               path("x.yaml"));
   EXPECT_EQ(bad.exit_code, 1) << bad.output;
   EXPECT_NE(bad.output.find("bad_labels.csv"), std::string::npos) << bad.output;
 }
@@ -126,9 +126,9 @@ TEST_F(CalibrateCli, BadInputIsAOneLineErrorOrUsage) {
                   path("x.yaml"),
               "ball");
   // One press only.
-  expectError(bg + " --presses " + path("press0.png") + " --ball-diameter-mm 6 -o " +
-                  path("x.yaml"),
-              "at least 4");
+  expectError(
+      bg + " --presses " + path("press0.png") + " --ball-diameter-mm 6 -o " + path("x.yaml"),
+      "at least 4");
   // A missing file is named.
   expectError(bg + " --presses" + presses_ + " " + path("missing.png") +
                   " --ball-diameter-mm 6 -o " + path("x.yaml"),

@@ -42,11 +42,11 @@ constexpr double kMaxSearchedScale = 0.1;
 
 /// A least-squares fit of the calibrated response to presses.
 struct ShadingFit {
-  ShadingOptions shading;           ///< response fitted; gain 1; shadow_sigma_mm as used
-  PressGeometry geometry;           ///< as used
-  GelOptions gel;                   ///< the gel smoothing used (base's; not fitted)
+  ShadingOptions shading;              ///< response fitted; gain 1; shadow_sigma_mm as used
+  PressGeometry geometry;              ///< as used
+  GelOptions gel;                      ///< the gel smoothing used (base's; not fitted)
   bool scale_at_search_bound = false;  ///< the fitted scale is an end of the searched range
-  double variance_explained = 0.0;  ///< on the fitted presses, pixels of kFitRegionRadii
+  double variance_explained = 0.0;     ///< on the fitted presses, pixels of kFitRegionRadii
 };
 
 /// Fits the response (per channel, all features of digit_shader_response.hpp) to `presses` at
@@ -56,9 +56,9 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
                               double shadow_sigma_mm);
 
 /// Fits the response and the geometry: the radius factor always, the scale when
-/// `mm_per_pixel` is not given, and the rim-shadow width; each chosen as the one whose fit explains the most
-/// variance (a coarse grid, then a local pattern search). Throws Error when no scale in the
-/// searched range (kMinSearchedScale-kMaxSearchedScale mm/px at QVGA, halved at VGA) fits the
+/// `mm_per_pixel` is not given, and the rim-shadow width; each chosen as the one whose fit explains
+/// the most variance (a coarse grid, then a local pattern search). Throws Error when no scale in
+/// the searched range (kMinSearchedScale-kMaxSearchedScale mm/px at QVGA, halved at VGA) fits the
 /// ball.
 /// With `start`, the coarse grid is skipped and the local search starts there (a refit).
 ShadingFit fitShadingAndGeometry(const SensorModel& base,

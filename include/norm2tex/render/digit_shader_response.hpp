@@ -73,7 +73,6 @@ void applyShadingResponse(const ShadingFeatureArray& features, const ShadingOpti
 /// fused for the renderer: no feature planes; the position-dependent terms are folded into
 /// per-row coefficients a + b u, and four pixels run at once (SIMD). `diff` is box-sized.
 void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
-                              const ShadingOptions& shading, const cv::Rect& box,
-                              cv::Mat3f& diff);
+                              const ShadingOptions& shading, const cv::Rect& box, cv::Mat3f& diff);
 
 }  // namespace norm2tex

@@ -43,11 +43,11 @@ struct ShadingOptions {
 /// DIGIT frames.
 struct NoiseOptions {
   cv::Vec3d sigma_bgr{2.8, 1.5, 2.5};  ///< grey levels (of 255), per channel, OpenCV order
-  double neighbour_correlation = 0.6;   ///< between horizontally / vertically adjacent pixels
-  double correlation_bg = -0.33;        ///< between the blue and green noise of one pixel
-  double correlation_gr = -0.42;        ///< green and red
-  double correlation_br = 0.0;          ///< blue and red
-  bool on_real_background = false;      ///< add noise on top of a captured background too
+  double neighbour_correlation = 0.6;  ///< between horizontally / vertically adjacent pixels
+  double correlation_bg = -0.33;       ///< between the blue and green noise of one pixel
+  double correlation_gr = -0.42;       ///< green and red
+  double correlation_br = 0.0;         ///< blue and red
+  bool on_real_background = false;     ///< add noise on top of a captured background too
 };
 
 /// Elastomer smoothing (see GelModel): Taxim-style pyramid of Gaussian blurs that restores the
@@ -74,6 +74,11 @@ struct SensorModel {
   /// 17-19.6 px/mm at QVGA; the default, 0.054, is the calibration set's unit (18.5 px/mm).
   double mm_per_pixel = 0.054;
   double gel_thickness_mm = 4.6;  ///< indentation is clamped to this
+  /// The physical gel pad, which the gripper physics presses against (setGelFromSensor). The
+  /// camera sees only its middle (gelWidthMm() x gelHeightMm(), about 13 x 17 mm at the
+  /// measured scale); quoted DIGIT gels are 18.35 x 24.6 to 20 x 30 mm.
+  double gel_pad_width_mm = 19.2;
+  double gel_pad_height_mm = 25.6;
   double gel_curvature_radius_mm = 0.0;  ///< 0 = flat gel; else a dome of this radius
   double fx = 277.1, fy = 277.1;         ///< camera_info intrinsics, pixels
   double cx = 119.5, cy = 159.5;         ///< principal point, pixels
@@ -83,6 +88,7 @@ struct SensorModel {
   std::string background_image;  ///< user's no-contact frame (BGR); empty = synthetic
   GelOptions gel;
 
+  /// The imaged part of the gel (cols x mm_per_pixel by rows x mm_per_pixel).
   double gelWidthMm() const { return cols * mm_per_pixel; }
   double gelHeightMm() const { return rows * mm_per_pixel; }
   cv::Size imageSize() const { return {cols, rows}; }

@@ -79,8 +79,9 @@ NoiseOptions measureBackgroundNoise(const std::vector<cv::Mat3b>& backgrounds) {
   std::vector<cv::Mat3f> residuals;
   for (const cv::Mat3b& frame : backgrounds) {
     if (frame.size() != backgrounds[0].size() || frame.rows < 16 || frame.cols < 16) {
-      throw Error("measureBackgroundNoise: background frames must share one size of at least 16 "
-                  "x 16 pixels");
+      throw Error(
+          "measureBackgroundNoise: background frames must share one size of at least 16 "
+          "x 16 pixels");
     }
     cv::Mat3f f;
     frame.convertTo(f, CV_32F);

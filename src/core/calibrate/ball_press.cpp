@@ -22,11 +22,11 @@ cv::Mat1f ballPressIndentation(const SensorModel& model, const PressCircle& cont
   const double depth = big_r - std::sqrt(big_r * big_r - a * a);
   cv::Mat1f h(model.rows, model.cols, 0.0f);
   const int r0 = std::max(0, static_cast<int>(std::floor(contact.centre_px.y - contact.radius_px)));
-  const int r1 =
-      std::min(model.rows - 1, static_cast<int>(std::ceil(contact.centre_px.y + contact.radius_px)));
+  const int r1 = std::min(model.rows - 1,
+                          static_cast<int>(std::ceil(contact.centre_px.y + contact.radius_px)));
   const int c0 = std::max(0, static_cast<int>(std::floor(contact.centre_px.x - contact.radius_px)));
-  const int c1 =
-      std::min(model.cols - 1, static_cast<int>(std::ceil(contact.centre_px.x + contact.radius_px)));
+  const int c1 = std::min(model.cols - 1,
+                          static_cast<int>(std::ceil(contact.centre_px.x + contact.radius_px)));
   for (int r = r0; r <= r1; ++r) {
     float* row = h.ptr<float>(r);
     for (int c = c0; c <= c1; ++c) {

@@ -14,8 +14,8 @@ constexpr int kTile = 160;
 constexpr double kCropRadii = 1.6;
 constexpr int kLineHeight = 16;
 
-std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0,
-                   double d = 0.0, double e = 0.0, double f = 0.0) {
+std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0, double d = 0.0,
+                   double e = 0.0, double f = 0.0) {
   char text[256];
   std::snprintf(text, sizeof(text), pattern, a, b, c, d, e, f);
   return text;
@@ -37,9 +37,8 @@ cv::Mat3b cropTile(const cv::Mat3b& image, cv::Point2d centre, double half) {
 std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
   const FitQuality& q = r.held_out;
   return {
-      format("scale %.4f mm/px (%.1f px/mm), rim shadow sigma %.2f mm",
-             r.fit.geometry.mm_per_pixel, 1.0 / r.fit.geometry.mm_per_pixel,
-             r.fit.shading.shadow_sigma_mm),
+      format("scale %.4f mm/px (%.1f px/mm), rim shadow sigma %.2f mm", r.fit.geometry.mm_per_pixel,
+             1.0 / r.fit.geometry.mm_per_pixel, r.fit.shading.shadow_sigma_mm),
       format("fit on %.0f presses explains %.2f of their variance; %.0f held out:",
              r.training_presses, r.fit.variance_explained, q.presses),
       format("  variance explained %.2f", q.variance_explained),

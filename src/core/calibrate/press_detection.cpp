@@ -52,7 +52,8 @@ PressCircle detectPress(const cv::Mat3f& diff, const std::string& frame_name) {
   for (int r = 0; r < diff.rows; ++r) {
     const cv::Vec3f* d = diff.ptr<cv::Vec3f>(r);
     float* m = magnitude.ptr<float>(r);
-    for (int c = 0; c < diff.cols; ++c) m[c] = std::abs(d[c][0]) + std::abs(d[c][1]) + std::abs(d[c][2]);
+    for (int c = 0; c < diff.cols; ++c)
+      m[c] = std::abs(d[c][0]) + std::abs(d[c][1]) + std::abs(d[c][2]);
   }
   const double sigma = kBlurSigmaAtQvgaPx * diff.cols / 240.0;
   const int radius = static_cast<int>(std::ceil(3.0 * sigma));
@@ -78,8 +79,8 @@ PressCircle detectPress(const cv::Mat3f& diff, const std::string& frame_name) {
   }
   if (best_area < kMinRegionPixels) {
     throw Error("press '" + frame_name + "': no press found (the changed region has only " +
-                std::to_string(best_area) + " pixels; need >= " +
-                std::to_string(kMinRegionPixels) + ")");
+                std::to_string(best_area) + " pixels; need >= " + std::to_string(kMinRegionPixels) +
+                ")");
   }
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(cv::Mat1b(labels == best), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);

@@ -22,10 +22,9 @@ double residual(const DigitShader& shader, const SensorModel& model, const Press
   }
   const cv::Mat1f gel = simulatedPressGel(model, circle, {model.mm_per_pixel, 1.0}, ball_radius_mm);
   const cv::Mat3f render = shader.shadingDifference(gel);
-  const cv::Rect region =
-      cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius), cvCeil(2 * radius) + 2,
-               cvCeil(2 * radius) + 2) &
-      cv::Rect(0, 0, press.diff.cols, press.diff.rows);
+  const cv::Rect region = cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius),
+                                   cvCeil(2 * radius) + 2, cvCeil(2 * radius) + 2) &
+                          cv::Rect(0, 0, press.diff.cols, press.diff.rows);
   double sum = 0.0;
   for (int r = region.y; r < region.y + region.height; ++r) {
     const cv::Vec3f* real = press.diff.ptr<cv::Vec3f>(r);
@@ -56,13 +55,12 @@ PressCircle refinePressCircle(const DigitShader& shader, const SensorModel& mode
     for (int round = 0; improved && round < 6; ++round) {
       improved = false;
       const PressCircle from = best;
-      const PressCircle moves[6] = {
-          {from.centre_px + cv::Point2d(step, 0), from.radius_px},
-          {from.centre_px - cv::Point2d(step, 0), from.radius_px},
-          {from.centre_px + cv::Point2d(0, step), from.radius_px},
-          {from.centre_px - cv::Point2d(0, step), from.radius_px},
-          {from.centre_px, from.radius_px * (1.0 + radius_step)},
-          {from.centre_px, from.radius_px / (1.0 + radius_step)}};
+      const PressCircle moves[6] = {{from.centre_px + cv::Point2d(step, 0), from.radius_px},
+                                    {from.centre_px - cv::Point2d(step, 0), from.radius_px},
+                                    {from.centre_px + cv::Point2d(0, step), from.radius_px},
+                                    {from.centre_px - cv::Point2d(0, step), from.radius_px},
+                                    {from.centre_px, from.radius_px * (1.0 + radius_step)},
+                                    {from.centre_px, from.radius_px / (1.0 + radius_step)}};
       for (const PressCircle& candidate : moves) {
         const double value =
             residual(shader, model, press, candidate, ball_radius_mm, centre, region_radius);

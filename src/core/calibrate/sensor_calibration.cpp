@@ -60,8 +60,7 @@ void removeDrift(PressObservation& press) {
   if (values[0].size() < 100) return;  // the press fills the frame: nothing to compare with
   cv::Vec3f offset;
   for (int k = 0; k < 3; ++k) {
-    std::nth_element(values[k].begin(), values[k].begin() + values[k].size() / 2,
-                     values[k].end());
+    std::nth_element(values[k].begin(), values[k].begin() + values[k].size() / 2, values[k].end());
     offset[k] = values[k][values[k].size() / 2];
   }
   press.diff -= cv::Scalar(offset[0], offset[1], offset[2]);
@@ -80,7 +79,8 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   }
   if (!(input.ball_diameter_mm > 0.0 && input.ball_diameter_mm <= 100.0)) {
     std::ostringstream message;
-    message << "ball diameter = " << input.ball_diameter_mm << " mm is out of range; valid: (0, 100]";
+    message << "ball diameter = " << input.ball_diameter_mm
+            << " mm is out of range; valid: (0, 100]";
     throw Error(message.str());
   }
   if (!input.labels.empty() && input.labels.size() != input.presses.size()) {
@@ -121,7 +121,8 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
   // A first fit on the detected circles, then every press's circle refined against it (labelled
   // ones are kept), then the final fit.
-  const ShadingFit first = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
+  const ShadingFit first =
+      fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
   {
     SensorModel model = base;
     model.mm_per_pixel = first.geometry.mm_per_pixel;
@@ -162,8 +163,8 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
     result.held_out_radii_px.push_back(press.circle.radius_px * result.fit.geometry.radius_factor);
   }
   result.held_out_presses = std::move(held_out);
-  result.held_out = compareWithReal(result.held_out_presses, result.held_out_simulated,
-                                    result.held_out_radii_px);
+  result.held_out =
+      compareWithReal(result.held_out_presses, result.held_out_simulated, result.held_out_radii_px);
   return result;
 }
 

@@ -37,10 +37,9 @@ void accumulate(const SensorModel& model, const PressObservation& press, const c
   }
   const double radius = kFitRegionRadii * press.circle.radius_px;
   const cv::Point2d centre = press.circle.centre_px;
-  const cv::Rect region =
-      cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius), cvCeil(2 * radius) + 2,
-               cvCeil(2 * radius) + 2) &
-      image;
+  const cv::Rect region = cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius),
+                                   cvCeil(2 * radius) + 2, cvCeil(2 * radius) + 2) &
+                          image;
   // Rows of features and targets of the region's pixels, then A += F^T F and B += F^T Y by
   // matrix products (much faster than per-pixel rank-one updates).
   cv::Mat1f f_rows(region.area(), kF, 0.0f), y_rows(region.area(), 3);
@@ -143,7 +142,8 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  std::optional<PressGeometry> start) {
   if (presses.empty()) throw Error("fitShadingAndGeometry: no presses");
   double largest_radius_px = 0.0;
-  for (const PressObservation& p : presses) largest_radius_px = std::max(largest_radius_px, p.circle.radius_px);
+  for (const PressObservation& p : presses)
+    largest_radius_px = std::max(largest_radius_px, p.circle.radius_px);
   const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
   const double scale_lo = kMinSearchedScale * qvga, scale_hi = kMaxSearchedScale * qvga;
   const double factor_lo = 0.6, factor_hi = 1.3;
@@ -153,8 +153,8 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   };
   if (mm_per_pixel && *mm_per_pixel > feasibleScale(factor_lo)) {
     std::ostringstream message;
-    message << "the largest press (contact radius " << largest_radius_px << " px = "
-            << largest_radius_px * *mm_per_pixel << " mm at " << *mm_per_pixel
+    message << "the largest press (contact radius " << largest_radius_px
+            << " px = " << largest_radius_px * *mm_per_pixel << " mm at " << *mm_per_pixel
             << " mm/px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
             << " mm can make; check --ball-diameter-mm and --mm-per-pixel";
     throw Error(message.str());
@@ -175,7 +175,8 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   const auto tryGeometry = [&](PressGeometry g, double sigma) {
     g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
     if (mm_per_pixel) g.mm_per_pixel = *mm_per_pixel;
-    g.mm_per_pixel = std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
+    g.mm_per_pixel =
+        std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
     if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) return false;
     const ShadingFit fit = fitShadingResponse(model, presses, g, ball_radius_mm, sigma);
     if (fit.variance_explained <= best.variance_explained) return false;
@@ -243,7 +244,8 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   }
   const double s = best.geometry.mm_per_pixel;
   best.scale_at_search_bound =
-      !mm_per_pixel && (s <= scale_lo * 1.01 || s >= 0.99 * std::min(scale_hi, feasibleScale(best.geometry.radius_factor)));
+      !mm_per_pixel && (s <= scale_lo * 1.01 ||
+                        s >= 0.99 * std::min(scale_hi, feasibleScale(best.geometry.radius_factor)));
   return best;
 }
 

@@ -14,10 +14,10 @@
 namespace norm2tex {
 namespace {
 
-// analytic_leds response: x = kShadingScale * (shading(H) - shading(flat)) per channel, in grey levels per
-// unit of n . l, then a soft knee x / (1 + |x| / kKneeGreyLevels) and shading_gain. Fitted so
-// that a ball of 8.8 mm pressed 1.5 mm into the gel, through the GelModel, differs from the
-// background inside the contact by 32 grey levels on average with a 95th percentile of 44 and
+// analytic_leds response: x = kShadingScale * (shading(H) - shading(flat)) per channel, in grey
+// levels per unit of n . l, then a soft knee x / (1 + |x| / kKneeGreyLevels) and shading_gain.
+// Fitted so that a ball of 8.8 mm pressed 1.5 mm into the gel, through the GelModel, differs from
+// the background inside the contact by 32 grey levels on average with a 95th percentile of 44 and
 // a peak of 94; real DIGIT ball presses measure about 29 and 48. Our contact shading is more
 // uniform than a real one (48 / 29 = 1.65 there, 1.4 here), so mean and tail cannot both
 // match; a strong knee (70) matched the mean (30) but cut the tail to 36. The knee keeps steep
@@ -155,8 +155,7 @@ void DigitShader::shadeBox(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& d
   computeShadingDifference(h, model_.mm_per_pixel, model_.shading, box, diff);
 }
 
-void DigitShader::shadeBoxAnalytic(const cv::Mat1f& h, const cv::Rect& box,
-                                   cv::Mat3f& diff) const {
+void DigitShader::shadeBoxAnalytic(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& diff) const {
   // Slopes in consistent units: dH (mm) over the pixel spacing (mm).
   const float inv_pixel = static_cast<float>(1.0 / model_.mm_per_pixel);
   const int last_row = h.rows - 1, last_col = h.cols - 1;

@@ -90,7 +90,8 @@ DigitShaderNoise::DigitShaderNoise(const NoiseOptions& o) {
   const cv::Vec3d s = o.sigma_bgr;
   const cv::Matx33d cov(s[0] * s[0], o.correlation_bg * s[0] * s[1], o.correlation_br * s[0] * s[2],
                         o.correlation_bg * s[0] * s[1], s[1] * s[1], o.correlation_gr * s[1] * s[2],
-                        o.correlation_br * s[0] * s[2], o.correlation_gr * s[1] * s[2], s[2] * s[2]);
+                        o.correlation_br * s[0] * s[2], o.correlation_gr * s[1] * s[2],
+                        s[2] * s[2]);
   cv::Matx33d l = cv::Matx33d::zeros();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j <= i; ++j) {
@@ -120,7 +121,8 @@ void DigitShaderNoise::generate(cv::Size size, std::uint64_t seed, cv::Mat3f& no
     for (int k = 0; k < row_samples; k += kSamplesPerDraw) {
       std::uint64_t bits = generator.next();
       const int count = std::min(kSamplesPerDraw, row_samples - k);
-      for (int j = 0; j < count; ++j, bits >>= kTableBits) out[k + j] = table[bits & (kTableSize - 1)];
+      for (int j = 0; j < count; ++j, bits >>= kTableBits)
+        out[k + j] = table[bits & (kTableSize - 1)];
     }
   }
   cv::sepFilter2D(white, smooth, CV_32F, kernel_, kernel_, cv::Point(-1, -1), 0.0,

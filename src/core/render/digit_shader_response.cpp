@@ -13,11 +13,10 @@ namespace norm2tex {
 namespace {
 
 const char* const kFeatureNames[kShadingFeatureCount] = {
-    "slope_x", "slope_y", "slope_xx", "slope_xy", "slope_yy",
-    "depth",   "rim_out", "rim_in", "rim_right", "rim_left", "rim_down", "rim_up",
-    "slope_x*u", "slope_x*v", "slope_y*u", "slope_y*v",
-    "rim_right*u", "rim_right*v", "rim_left*u", "rim_left*v", "rim_down*u", "rim_down*v", "rim_up*u", "rim_up*v"};
-
+    "slope_x",    "slope_y",    "slope_xx",   "slope_xy",   "slope_yy",    "depth",
+    "rim_out",    "rim_in",     "rim_right",  "rim_left",   "rim_down",    "rim_up",
+    "slope_x*u",  "slope_x*v",  "slope_y*u",  "slope_y*v",  "rim_right*u", "rim_right*v",
+    "rim_left*u", "rim_left*v", "rim_down*u", "rim_down*v", "rim_up*u",    "rim_up*v"};
 
 // Gaussian blur of gel_mm over `region` with a wide sigma (pixels), replicating the image
 // border. Wide blurs run on a copy reduced by a whole factor (sigma / kSigmaPerReducedPixel,
@@ -49,10 +48,11 @@ void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, 
   const int x0 = region.x / factor * factor, y0 = region.y / factor * factor;
   const int x1 = (region.x + region.width + factor - 1) / factor * factor;
   const int y1 = (region.y + region.height + factor - 1) / factor * factor;
-  const cv::Rect inside = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  const cv::Rect inside =
+      cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
   cv::Mat1f& snapped = scratch.snapped;
-  cv::copyMakeBorder(gel_mm(inside), snapped, 0, y1 - y0 - inside.height, 0,
-                     x1 - x0 - inside.width, cv::BORDER_REPLICATE);
+  cv::copyMakeBorder(gel_mm(inside), snapped, 0, y1 - y0 - inside.height, 0, x1 - x0 - inside.width,
+                     cv::BORDER_REPLICATE);
   cv::Mat1f& small = factor > 1 ? scratch.small : snapped;
   if (factor > 1) {
     cv::resize(snapped, small, cv::Size(snapped.cols / factor, snapped.rows / factor), 0, 0,
@@ -60,8 +60,8 @@ void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, 
   }
   const double sigma_small = sigma_px / factor;
   const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_small)));
-  cv::GaussianBlur(small, small, cv::Size(2 * radius + 1, 2 * radius + 1), sigma_small,
-                   sigma_small, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(small, small, cv::Size(2 * radius + 1, 2 * radius + 1), sigma_small, sigma_small,
+                   cv::BORDER_REPLICATE);
   cv::Mat1f& full = factor > 1 ? scratch.full : small;
   if (factor > 1) cv::resize(small, full, snapped.size(), 0, 0, cv::INTER_LINEAR);
   full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).copyTo(out);
@@ -79,26 +79,18 @@ std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse()
   // Fitted by norm2tex_calibrate on digit_calibration_s09 (see config/digit.yaml, which holds
   // the same numbers, and README "Calibrate your own DIGIT").
   // Rows B, G, R; columns in the order of shadingFeatureNames().
-  return {{
-      {{ // blue
-       -1.7029, -27.0042, -22.5671, 8.1038, 50.1430, 1.2310,
-       -14.0443, -29.4138, -3.9875, 49.1282, -195.7080, 136.3275,
-       -10.2096, 39.5105, -24.7101, -33.8021, 31.6150, -23.9993,
-       -56.9498, -28.5463, 74.1623, -68.9803, -81.8773, 74.9964
-      }},
-      {{ // green
-       22.7729, -14.1977, 6.5536, 11.9932, -11.0092, -1.8850,
-       4.3925, -8.6974, 34.8648, -56.6451, 60.3049, -34.5307,
-       31.0407, -24.5424, 42.9954, -46.6421, 71.4478, -53.8582,
-       -25.5489, -13.7633, -21.3278, 109.7863, 33.0463, -88.1230
-      }},
-      {{ // red
-       -40.9611, 28.8587, 10.4038, -19.5692, -25.0703, 17.6520,
-       -7.5369, 51.8362, -126.7547, 102.7007, 114.6011, -98.8973,
-       57.8865, 41.4779, -60.4570, -36.5937, 134.7587, 109.4196,
-       -140.2055, -132.1345, -36.4502, 113.7772, 22.2459, -70.8375
-      }}
-  }};
+  return {{{{// blue
+             -1.7029, -27.0042, -22.5671,  8.1038,   50.1430,  1.2310,   -14.0443, -29.4138,
+             -3.9875, 49.1282,  -195.7080, 136.3275, -10.2096, 39.5105,  -24.7101, -33.8021,
+             31.6150, -23.9993, -56.9498,  -28.5463, 74.1623,  -68.9803, -81.8773, 74.9964}},
+           {{// green
+             22.7729, -14.1977, 6.5536,   11.9932,  -11.0092, -1.8850,  4.3925,  -8.6974,
+             34.8648, -56.6451, 60.3049,  -34.5307, 31.0407,  -24.5424, 42.9954, -46.6421,
+             71.4478, -53.8582, -25.5489, -13.7633, -21.3278, 109.7863, 33.0463, -88.1230}},
+           {{// red
+             -40.9611,  28.8587,  10.4038,   -19.5692,  -25.0703, 17.6520,  -7.5369,  51.8362,
+             -126.7547, 102.7007, 114.6011,  -98.8973,  57.8865,  41.4779,  -60.4570, -36.5937,
+             134.7587,  109.4196, -140.2055, -132.1345, -36.4502, 113.7772, 22.2459,  -70.8375}}}};
 }
 
 int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm) {
@@ -174,8 +166,7 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
 }
 
 void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
-                              const ShadingOptions& shading, const cv::Rect& box,
-                              cv::Mat3f& diff) {
+                              const ShadingOptions& shading, const cv::Rect& box, cv::Mat3f& diff) {
   if ((box & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows)) != box || box.empty()) {
     throw Error("computeShadingDifference: box outside the image");
   }
@@ -273,16 +264,19 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
       for (int q = 0; q < 6; ++q) fixed[k][q] = cv::v_setall_f32(w[k][2 + q]);  // features 2-7
     }
     for (int i = 0; i < padded; i += kLanes) {
-      const v_float32x4 u =
-          cv::v_setall_f32((box.x + i + 0.5f) * inv_half_cols - 1.0f) + lane_u;
+      const v_float32x4 u = cv::v_setall_f32((box.x + i + 0.5f) * inv_half_cols - 1.0f) + lane_u;
       const v_float32x4 x = cv::v_load(&gx[i]), y = cv::v_load(&gy[i]);
       const v_float32x4 depth = cv::v_load(&hh[i]);
       const v_float32x4 rim_v = cv::v_load(&rim[i]);
       const v_float32x4 bxv = cv::v_load(&bx[i]), byv = cv::v_load(&by[i]);
-      const v_float32x4 varying[kVarying] = {x, y, cv::v_max(bxv, zero), cv::v_max(zero - bxv, zero),
-                                             cv::v_max(byv, zero), cv::v_max(zero - byv, zero)};
-      const v_float32x4 constant[6] = {x * x, x * y, y * y, depth, cv::v_max(rim_v, zero),
-                                       cv::v_min(rim_v, zero)};
+      const v_float32x4 varying[kVarying] = {x,
+                                             y,
+                                             cv::v_max(bxv, zero),
+                                             cv::v_max(zero - bxv, zero),
+                                             cv::v_max(byv, zero),
+                                             cv::v_max(zero - byv, zero)};
+      const v_float32x4 constant[6] = {
+          x * x, x * y, y * y, depth, cv::v_max(rim_v, zero), cv::v_min(rim_v, zero)};
       v_float32x4 channel[3];
       if (cv::v_check_all((x == zero) & (y == zero) & (depth == zero))) {
         // Outside the deformation (most of the box: the rim shadow's reach) only the rim terms

@@ -8,8 +8,8 @@
 #include <set>
 #include <sstream>
 
-#include <opencv2/core.hpp>
 #include <yaml-cpp/yaml.h>
+#include <opencv2/core.hpp>
 
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
@@ -33,16 +33,18 @@ const char* const kChannelNames[3] = {"blue", "green", "red"};
 // Every key a sensor yaml may hold, by section ("" = top level): anything else is a typo.
 const std::set<std::string>& allowedKeys(const std::string& section) {
   static const std::map<std::string, std::set<std::string>> keys = {
-      {"", {"preset", "image", "gel", "camera", "leds", "shading", "noise", "background_image",
-            "gel_model"}},
+      {"",
+       {"preset", "image", "gel", "camera", "leds", "shading", "noise", "background_image",
+        "gel_model"}},
       {"image", {"rows", "cols", "mm_per_pixel"}},
-      {"gel", {"thickness_mm", "curvature_radius_mm"}},
+      {"gel", {"thickness_mm", "curvature_radius_mm", "pad_width_mm", "pad_height_mm"}},
       {"camera", {"fx", "fy", "cx", "cy"}},
       {"leds[]", {"name", "position_mm", "color_bgr", "intensity"}},
       {"shading", {"model", "gain", "shadow_sigma_mm", "response"}},
       {"shading.response", {"blue", "green", "red"}},
-      {"noise", {"sigma_bgr", "neighbour_correlation", "correlation_bg", "correlation_gr",
-                 "correlation_br", "on_real_background"}},
+      {"noise",
+       {"sigma_bgr", "neighbour_correlation", "correlation_bg", "correlation_gr", "correlation_br",
+        "on_real_background"}},
       {"gel_model", {"pyramid_sigmas_mm", "core_fraction", "final_sigma_mm"}},
   };
   return keys.at(section);
@@ -102,8 +104,8 @@ void readShading(const YAML::Node& node, ShadingOptions& shading) {
       const std::vector<double> values = response[kChannelNames[k]].as<std::vector<double>>();
       if (values.size() != static_cast<size_t>(kShadingFeatureCount)) {
         throw Error(std::string("shading.response.") + kChannelNames[k] + " needs " +
-                    std::to_string(kShadingFeatureCount) + " numbers (" +
-                    shadingFeatureNames() + "), got " + std::to_string(values.size()));
+                    std::to_string(kShadingFeatureCount) + " numbers (" + shadingFeatureNames() +
+                    "), got " + std::to_string(values.size()));
       }
       std::copy(values.begin(), values.end(), shading.response_bgr[k].begin());
     }
@@ -156,6 +158,10 @@ void validate(const SensorModel& m) {
                    m.gel_thickness_mm, "(0, 20] mm");
   requireParameter(m.gel_curvature_radius_mm == 0.0 || m.gel_curvature_radius_mm > 5.0,
                    "gel.curvature_radius_mm", m.gel_curvature_radius_mm, "0 (flat) or > 5 mm");
+  requireParameter(m.gel_pad_width_mm > 0.0 && m.gel_pad_width_mm <= 100.0, "gel.pad_width_mm",
+                   m.gel_pad_width_mm, "(0, 100] mm");
+  requireParameter(m.gel_pad_height_mm > 0.0 && m.gel_pad_height_mm <= 100.0,
+                   "gel.pad_height_mm", m.gel_pad_height_mm, "(0, 100] mm");
   requireParameter(m.fx > 0.0 && m.fy > 0.0, "camera.fx/fy", m.fx, "> 0 pixels");
   requireParameter(std::isfinite(m.cx) && std::isfinite(m.cy), "camera.cx/cy", m.cx, "finite");
   for (const LedModel& led : m.leds) {
@@ -170,8 +176,8 @@ void validate(const SensorModel& m) {
   }
   const ShadingOptions& s = m.shading;
   requireParameter(s.gain >= 0.0 && s.gain <= 100.0, "shading.gain", s.gain, "[0, 100]");
-  requireParameter(s.shadow_sigma_mm >= 0.05 && s.shadow_sigma_mm <= 3.0,
-                   "shading.shadow_sigma_mm", s.shadow_sigma_mm, "[0.05, 3] mm");
+  requireParameter(s.shadow_sigma_mm >= 0.05 && s.shadow_sigma_mm <= 3.0, "shading.shadow_sigma_mm",
+                   s.shadow_sigma_mm, "[0.05, 3] mm");
   for (int k = 0; k < 3; ++k) {
     for (const double value : s.response_bgr[k]) {
       requireParameter(std::isfinite(value) && std::abs(value) <= 1e5,
@@ -233,6 +239,8 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
     rejectUnknownKeys(root["gel"], "gel");
     read(root["gel"], "thickness_mm", m.gel_thickness_mm);
     read(root["gel"], "curvature_radius_mm", m.gel_curvature_radius_mm);
+    read(root["gel"], "pad_width_mm", m.gel_pad_width_mm);
+    read(root["gel"], "pad_height_mm", m.gel_pad_height_mm);
     rejectUnknownKeys(root["camera"], "camera");
     read(root["camera"], "fx", m.fx);
     read(root["camera"], "fy", m.fy);
@@ -291,17 +299,19 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
       << "image:\n  rows: " << m.rows << "\n  cols: " << m.cols
       << "\n  mm_per_pixel: " << m.mm_per_pixel << "\n"
       << "gel:\n  thickness_mm: " << m.gel_thickness_mm
-      << "\n  curvature_radius_mm: " << m.gel_curvature_radius_mm << "\n"
-      << "camera:\n  fx: " << m.fx << "\n  fy: " << m.fy << "\n  cx: " << m.cx
-      << "\n  cy: " << m.cy << "\n"
+      << "\n  curvature_radius_mm: " << m.gel_curvature_radius_mm
+      << "\n  pad_width_mm: " << m.gel_pad_width_mm << "\n  pad_height_mm: " << m.gel_pad_height_mm
+      << "\n"
+      << "camera:\n  fx: " << m.fx << "\n  fy: " << m.fy << "\n  cx: " << m.cx << "\n  cy: " << m.cy
+      << "\n"
       << "leds:\n";
   for (const LedModel& led : m.leds) {
     out << "  - name: " << led.name << "\n    position_mm: " << vec3(led.position_mm)
         << "\n    color_bgr: " << vec3(led.color_bgr) << "\n    intensity: " << led.intensity
         << "\n";
   }
-  out << "shading:\n  model: " << shadingKindName(m.shading.kind)
-      << "\n  gain: " << m.shading.gain << "\n  shadow_sigma_mm: " << m.shading.shadow_sigma_mm
+  out << "shading:\n  model: " << shadingKindName(m.shading.kind) << "\n  gain: " << m.shading.gain
+      << "\n  shadow_sigma_mm: " << m.shading.shadow_sigma_mm
       << "\n  response:   # grey levels per unit of: " << shadingFeatureNames() << "\n";
   for (int k = 0; k < 3; ++k) {
     out << "    " << kChannelNames[k] << ": [";
