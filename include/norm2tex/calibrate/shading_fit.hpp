@@ -60,6 +60,8 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
 /// the most variance (a coarse grid, then a local pattern search). Throws Error when no scale in
 /// the searched range (kMinSearchedScale-kMaxSearchedScale mm/px at QVGA, halved at VGA) fits the
 /// ball.
+/// When the scale is searched and there are more than 16 presses, the search runs on 16 of
+/// them spread evenly over the set, and the response is then fitted on all.
 /// With `start`, the coarse grid is skipped and the local search starts there (a refit).
 ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  const std::vector<PressObservation>& presses,

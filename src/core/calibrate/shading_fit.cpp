@@ -15,6 +15,7 @@ namespace norm2tex {
 namespace {
 
 constexpr int kF = kShadingFeatureCount;
+constexpr size_t kMaxSearchPresses = 16;
 
 // Normal equations of the per-channel least squares, pooled over presses.
 struct NormalEquations {
@@ -171,6 +172,16 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   const double default_sigma = makeDigitSensorModel().shading.shadow_sigma_mm;
   ShadingFit best;
   best.variance_explained = -1e300;
+  // Searching the scale renders every press for each candidate: with many presses, search on
+  // an evenly spread subset of kMaxSearchPresses, then fit the response on all of them.
+  std::vector<PressObservation> subset;
+  const bool use_subset = !mm_per_pixel && presses.size() > kMaxSearchPresses;
+  if (use_subset) {
+    for (size_t i = 0; i < kMaxSearchPresses; ++i) {
+      subset.push_back(presses[i * presses.size() / kMaxSearchPresses]);
+    }
+  }
+  const std::vector<PressObservation>& search = use_subset ? subset : presses;
   SensorModel model = base;
   const auto tryGeometry = [&](PressGeometry g, double sigma) {
     g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
@@ -178,7 +189,7 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
     g.mm_per_pixel =
         std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
     if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) return false;
-    const ShadingFit fit = fitShadingResponse(model, presses, g, ball_radius_mm, sigma);
+    const ShadingFit fit = fitShadingResponse(model, search, g, ball_radius_mm, sigma);
     if (fit.variance_explained <= best.variance_explained) return false;
     best = fit;
     return true;
@@ -246,6 +257,12 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   best.scale_at_search_bound =
       !mm_per_pixel && (s <= scale_lo * 1.01 ||
                         s >= 0.99 * std::min(scale_hi, feasibleScale(best.geometry.radius_factor)));
+  if (use_subset) {
+    const bool at_bound = best.scale_at_search_bound;
+    best = fitShadingResponse(model, presses, best.geometry, ball_radius_mm,
+                              best.shading.shadow_sigma_mm);
+    best.scale_at_search_bound = at_bound;
+  }
   return best;
 }
 
