@@ -1,3 +1,4 @@
+#include <cmath>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -9,16 +10,87 @@
 namespace norm2tex {
 namespace {
 
+// config/digit.yaml is the calibrated s09 unit: the built-in defaults carry its shading, and
+// its own scale and background.
 TEST(SensorModel, ShippedConfigLoadsAndMatchesTheDefaults) {
   const SensorModel shipped = loadSensorModel(NORM2TEX_SOURCE_DIR "/config/digit.yaml");
   const SensorModel defaults = makeDigitSensorModel();
   EXPECT_EQ(shipped.rows, 320);
   EXPECT_EQ(shipped.cols, 240);
-  EXPECT_DOUBLE_EQ(shipped.mm_per_pixel, defaults.mm_per_pixel);
+  EXPECT_DOUBLE_EQ(shipped.mm_per_pixel, 0.0532);
+  EXPECT_NEAR(defaults.mm_per_pixel, 0.054, 1e-12);  // the measured 17-19.6 px/mm
   EXPECT_EQ(shipped.leds[0].name, "red");
   EXPECT_EQ(shipped.leds[0].position_mm, defaults.leds[0].position_mm);
   EXPECT_EQ(shipped.gel.pyramid_sigmas_mm, defaults.gel.pyramid_sigmas_mm);
-  EXPECT_TRUE(shipped.background_image.empty());
+  EXPECT_EQ(shipped.gel.final_sigma_mm, defaults.gel.final_sigma_mm);
+  EXPECT_EQ(shipped.shading.kind, ShadingKind::kCalibrated);
+  EXPECT_EQ(shipped.shading.shadow_sigma_mm, defaults.shading.shadow_sigma_mm);
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < kShadingFeatureCount; ++j) {
+      EXPECT_NEAR(shipped.shading.response_bgr[k][j], defaults.shading.response_bgr[k][j], 1e-9)
+          << "channel " << k << " feature " << j;
+    }
+  }
+  EXPECT_EQ(shipped.noise.sigma_bgr, defaults.noise.sigma_bgr);
+  EXPECT_FALSE(shipped.noise.on_real_background);
+  EXPECT_EQ(shipped.background_image, NORM2TEX_SOURCE_DIR "/config/digit_s09_background.png");
+}
+
+// Real units brighten red at the upper right of a press, green at its left and blue below:
+// the analytic preset's LEDs sit on those sides.
+TEST(SensorModel, AnalyticLedsSitWhereRealPressesBrightenEachColour) {
+  const SensorModel m = makeDigitSensorModel();
+  const auto angle = [](const LedModel& led) {
+    return std::atan2(led.position_mm[1], led.position_mm[0]) * 180.0 / CV_PI;
+  };
+  EXPECT_EQ(m.leds[0].name, "red");
+  EXPECT_NEAR(angle(m.leds[0]), -40.0, 15.0);  // real: -31 to -52 degrees (0 right, 90 down)
+  EXPECT_EQ(m.leds[1].name, "green");
+  EXPECT_NEAR(angle(m.leds[1]), -155.0, 15.0);  // real: -146 to -163
+  EXPECT_EQ(m.leds[2].name, "blue");
+  EXPECT_NEAR(angle(m.leds[2]), 70.0, 25.0);  // real: 57 to 84
+}
+
+TEST(SensorModel, SavedModelLoadsBackTheSame) {
+  test::ScratchDirectory dir;
+  SensorModel m = makeDigitSensorModel();
+  m.mm_per_pixel = 0.0517;
+  m.shading.response_bgr[1][3] = -12.25;
+  m.shading.shadow_sigma_mm = 0.45;
+  m.noise.sigma_bgr = {3.0, 1.25, 2.0};
+  m.noise.correlation_gr = -0.3;
+  m.gel.pyramid_sigmas_mm = {0.6, 0.2};
+  m.gel_pad_width_mm = 18.35;
+  m.background_image = "bg.png";
+  saveSensorModel(m, dir.path("saved.yaml"));
+  const SensorModel loaded = loadSensorModel(dir.path("saved.yaml"));
+  EXPECT_DOUBLE_EQ(loaded.mm_per_pixel, 0.0517);
+  EXPECT_DOUBLE_EQ(loaded.shading.response_bgr[1][3], -12.25);
+  EXPECT_EQ(loaded.shading.response_bgr, m.shading.response_bgr);
+  EXPECT_DOUBLE_EQ(loaded.shading.shadow_sigma_mm, 0.45);
+  EXPECT_EQ(loaded.noise.sigma_bgr, m.noise.sigma_bgr);
+  EXPECT_DOUBLE_EQ(loaded.noise.correlation_gr, -0.3);
+  EXPECT_EQ(loaded.gel.pyramid_sigmas_mm, m.gel.pyramid_sigmas_mm);
+  EXPECT_DOUBLE_EQ(loaded.gel_pad_width_mm, 18.35);
+  EXPECT_EQ(loaded.leds[1].position_mm, m.leds[1].position_mm);
+  EXPECT_EQ(loaded.background_image, dir.path("bg.png")) << "relative to the yaml";
+}
+
+TEST(SensorModel, UnknownKeysAreErrorsNamingTheKey) {
+  test::ScratchDirectory dir;
+  const auto expectUnknown = [&](const std::string& yaml, const std::string& key) {
+    std::ofstream(dir.path("typo.yaml")) << yaml;
+    test::expectError([&] { loadSensorModel(dir.path("typo.yaml")); },
+                      {"typo.yaml", "unknown key '" + key + "'"});
+  };
+  expectUnknown("mm_per_pixel: 0.05\n", "mm_per_pixel");  // belongs under image:
+  expectUnknown("image: {mm_per_pixle: 0.05}\n", "image.mm_per_pixle");
+  expectUnknown("noise_sigma: 2\n", "noise_sigma");  // replaced by noise.sigma_bgr
+  expectUnknown("noise: {sigma: 2}\n", "noise.sigma");
+  expectUnknown("shading: {gain: 1, modle: calibrated}\n", "shading.modle");
+  expectUnknown("shading: {response: {alpha: [1]}}\n", "shading.response.alpha");
+  expectUnknown("gel_model: {core: 0.4}\n", "gel_model.core");
+  expectUnknown("leds: [{name: a, colour: [1, 0, 0]}, {name: b}, {name: c}]\n", "leds[].colour");
 }
 
 TEST(SensorModel, PixelCentresMapToTheGelFrame) {
@@ -55,7 +127,13 @@ TEST(SensorModel, BadValuesNameTheFileAndKey) {
   };
   expectError("image: {rows: 0}\n", "image.rows");
   expectError("image: {mm_per_pixel: -1}\n", "image.mm_per_pixel");
-  expectError("noise_sigma: -2\n", "noise_sigma");
+  expectError("noise: {sigma_bgr: [2, -1, 2]}\n", "noise.sigma_bgr");
+  expectError("noise: {neighbour_correlation: 0.9}\n", "noise.neighbour_correlation");
+  expectError("noise: {correlation_bg: 0.9, correlation_gr: 0.9, correlation_br: -0.9}\n",
+              "positive definite");
+  expectError("shading: {model: phong}\n", "analytic_leds");
+  expectError("shading: {response: {blue: [1, 2, 3]}}\n", "shading.response.blue");
+  expectError("shading: {shadow_sigma_mm: 0}\n", "shading.shadow_sigma_mm");
   expectError("preset: hd\n", "preset");
   expectError("leds: [{name: red}]\n", "3 LEDs");
   expectError("image: {rows: [1, 2]}\n", "bad.yaml");

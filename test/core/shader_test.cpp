@@ -1,19 +1,25 @@
 // DigitShader and DIGIT backgrounds: exactness where nothing touches, noise statistics and
-// determinism, LED colours on the right side of a press, realistic magnitudes, synthetic
-// background statistics against real DIGIT frames, and the handling of bad inputs.
+// determinism, the calibrated response's features against analytic derivatives, a calibrated
+// press against real DIGIT measurements, the analytic LED preset's colour sides, realistic
+// magnitudes, synthetic background statistics against real DIGIT frames, and bad inputs.
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/calibrate/fit_quality.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/render/digit_shader_response.hpp"
+#include "norm2tex/render/gel_model.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {
@@ -79,11 +85,31 @@ bool messageContains(const std::function<void()>& call, const std::string& text)
   return false;
 }
 
+SensorModel analyticModel(bool vga = false) {
+  SensorModel model = makeDigitSensorModel(vga);
+  model.shading.kind = ShadingKind::kAnalyticLeds;
+  return model;
+}
+
+constexpr BackgroundSource kSynthetic = BackgroundSource::kSynthetic;
+
+// Standard deviation of `frame` minus its Gaussian blur (sigma 3 px), per channel pooled: the
+// measure of pixel noise used on real DIGIT frames.
+double highPassNoise(const cv::Mat3b& frame) {
+  cv::Mat3f f, blurred;
+  frame.convertTo(f, CV_32F);
+  cv::GaussianBlur(f, blurred, cv::Size(19, 19), 3.0);
+  const cv::Mat3f residual = (f - blurred)(cv::Rect(10, 10, f.cols - 20, f.rows - 20));
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(residual.clone().reshape(1), mean, stddev);
+  return stddev[0];
+}
+
 class ShaderTest : public ::testing::Test {
  protected:
   SensorModel model = makeDigitSensorModel();
   cv::Mat3b background = makeSyntheticBackground(model.imageSize());
-  DigitShader shader{model, background};
+  DigitShader shader{model, background, kSynthetic};
   cv::Mat1f flat = cv::Mat1f(model.rows, model.cols, 0.0f);
 };
 
@@ -94,25 +120,58 @@ TEST_F(ShaderTest, NoContactWithoutNoiseIsTheBackgroundBitForBit) {
   EXPECT_EQ(cv::countNonZero(shader.shadingDifference(flat).reshape(1)), 0);
 }
 
-TEST_F(ShaderTest, NoiseHasTheModelSigmaAndZeroMean) {
-  for (const double sigma : {2.0, 6.0}) {
+// Per-channel sigma, neighbour and cross-channel correlation as configured (the defaults are
+// what real DIGIT frames measure: B 2.8, G 1.5, R 2.5; 0.6; G-B -0.33, G-R -0.42).
+TEST_F(ShaderTest, NoiseHasTheMeasuredPerChannelSigmaAndCorrelations) {
+  for (const double scale : {1.0, 3.0}) {
     SensorModel noisy_model = model;
-    noisy_model.noise_sigma = sigma;
-    const DigitShader noisy(noisy_model, background);
-    const cv::Mat3f noise = difference(noisy.shade(flat, 7), background);
-    cv::Scalar mean, stddev;
-    cv::meanStdDev(noise.reshape(1), mean, stddev);
-    EXPECT_NEAR(stddev[0], sigma, 0.15 * sigma) << "sigma " << sigma;
-    EXPECT_NEAR(mean[0], 0.0, 0.05) << "sigma " << sigma;
-    // White: neighbouring pixels and channels are uncorrelated.
-    const cv::Mat1f flat_noise = noise.reshape(1, 1);
-    const cv::Mat1f a = flat_noise.colRange(0, flat_noise.cols - 3);
-    const cv::Mat1f next_pixel = flat_noise.colRange(3, flat_noise.cols);
-    const cv::Mat1f next_channel = flat_noise.colRange(1, flat_noise.cols - 2);
-    const cv::Mat1b all(a.size(), 255);
-    EXPECT_LT(std::abs(test::correlation(a, next_pixel, all)), 0.02);
-    EXPECT_LT(std::abs(test::correlation(a, next_channel, all)), 0.02);
+    noisy_model.noise.sigma_bgr *= scale;
+    const DigitShader noisy(noisy_model, background, kSynthetic);
+    // Away from the clipping range: a mid-grey background.
+    const cv::Mat3b grey(model.imageSize(), cv::Vec3b(128, 128, 128));
+    const DigitShader on_grey(noisy_model, grey, kSynthetic);
+    const cv::Mat3f noise = difference(on_grey.shade(flat, 7), grey);
+    std::vector<cv::Mat1f> planes;
+    cv::split(noise, planes);
+    const cv::Mat1b all(planes[0].size(), 255);
+    for (int k = 0; k < 3; ++k) {
+      const double sigma = noisy_model.noise.sigma_bgr[k];
+      // Rounding to grey levels adds 1/12 to the variance.
+      EXPECT_NEAR(test::maskedStdDev(planes[k], all), std::sqrt(sigma * sigma + 1.0 / 12.0),
+                  0.08 * sigma)
+          << "channel " << k << " scale " << scale;
+      EXPECT_NEAR(cv::mean(planes[k])[0], 0.0, 0.05 * sigma);
+      const cv::Rect left(0, 0, planes[k].cols - 1, planes[k].rows);
+      const cv::Mat1f a = planes[k](left).clone(),
+                      right = planes[k](left + cv::Point(1, 0)).clone();
+      if (scale > 1.0) {  // at sigma 1.5 the rounding to grey levels dilutes the correlation
+        EXPECT_NEAR(test::correlation(a, right, cv::Mat1b(a.size(), 255)), 0.6, 0.05) << k;
+      }
+    }
+    if (scale > 1.0) {
+      EXPECT_NEAR(test::correlation(planes[0], planes[1], all), -0.33, 0.05);
+      EXPECT_NEAR(test::correlation(planes[1], planes[2], all), -0.42, 0.05);
+      EXPECT_NEAR(test::correlation(planes[0], planes[2], all), 0.0, 0.05);
+    }
+    EXPECT_TRUE(noisy.addsNoise());
   }
+}
+
+// A captured background already carries the sensor's noise: by default nothing is added, so
+// the frame's high-pass noise stays the background's own (within 10 %); asking for noise on top
+// makes it grainier than the sensor, which the same measure sees.
+TEST_F(ShaderTest, NoiseOnACapturedBackgroundKeepsItsOwnNoiseLevel) {
+  // A "captured" frame: the synthetic background plus the default sensor noise, baked in.
+  const cv::Mat3b captured = shader.shade(flat, 99);
+  const double own = highPassNoise(captured);
+  ASSERT_GT(own, 0.5);
+  const DigitShader real(model, captured, BackgroundSource::kCaptured);
+  EXPECT_FALSE(real.addsNoise());
+  EXPECT_NEAR(highPassNoise(real.shade(flat, 5)), own, 0.1 * own);
+  SensorModel on_top = model;
+  on_top.noise.on_real_background = true;
+  const DigitShader grainy(on_top, captured, BackgroundSource::kCaptured);
+  EXPECT_GT(highPassNoise(grainy.shade(flat, 5)), 1.2 * own);
 }
 
 TEST_F(ShaderTest, SameSeedSameImageDifferentSeedsIndependentNoise) {
@@ -128,20 +187,25 @@ TEST_F(ShaderTest, SameSeedSameImageDifferentSeedsIndependentNoise) {
 
 TEST_F(ShaderTest, ZeroNoiseSigmaOrNegativeSeedAddsNoNoise) {
   SensorModel quiet_model = model;
-  quiet_model.noise_sigma = 0.0;
-  const DigitShader quiet(quiet_model, background);
+  quiet_model.noise.sigma_bgr = {0.0, 0.0, 0.0};
+  const DigitShader quiet(quiet_model, background, kSynthetic);
   EXPECT_TRUE(identical(quiet.shade(flat, 3), background));
   const cv::Mat1f h = sphericalCap(model, 3.0, 0.5);
   EXPECT_TRUE(identical(quiet.shade(h, 3), shader.shade(h, -1)));
 }
 
-// Outside the grown bounding box of the contact, the frame is exactly the no-contact frame,
-// with and without noise; the noise of a pixel does not depend on where the contact is.
+// Outside the bounding box of the contact grown by the shading's reach, the frame is exactly
+// the no-contact frame, with and without noise; the noise of a pixel does not depend on where
+// the contact is.
 TEST_F(ShaderTest, OutsideTheContactBoxTheFrameIsExactlyTheNoContactFrame) {
-  const cv::Mat1f h = sphericalCap(model, 3.0, 0.5, 2.0, -3.0);
+  const cv::Mat1f h = sphericalCap(model, 2.0, 0.3, 1.0, -1.5);
   const cv::Rect contact = cv::boundingRect(h > 0.0f);
+  const int reach = shader.reachPixels();
+  ASSERT_GE(reach, 2);
   cv::Mat1b outside(h.size(), 255);
-  outside(cv::Rect(contact.x - 2, contact.y - 2, contact.width + 4, contact.height + 4)) = 0;
+  outside(cv::Rect(contact.x - reach, contact.y - reach, contact.width + 2 * reach,
+                   contact.height + 2 * reach) &
+          cv::Rect(0, 0, h.cols, h.rows)) = 0;
   for (const std::int64_t seed : {-1, 5}) {
     const cv::Mat3b pressed = shader.shade(h, seed), untouched = shader.shade(flat, seed);
     cv::Mat1b same;
@@ -151,10 +215,11 @@ TEST_F(ShaderTest, OutsideTheContactBoxTheFrameIsExactlyTheNoContactFrame) {
     EXPECT_EQ(cv::countNonZero(same & outside), 0) << "seed " << seed;
     EXPECT_GT(cv::countNonZero(same), 100) << "seed " << seed;  // the contact shows
   }
-  // Where the gel is locally flat (no indentation in the 3 x 3 neighbourhood) the shading
-  // difference is exactly 0, also inside the box.
+  // Where the gel is flat within the reach the shading difference is exactly 0, also inside the
+  // box.
   cv::Mat1b touched;
-  cv::dilate(h > 0.0f, touched, cv::Mat());
+  cv::dilate(h > 0.0f, touched,
+             cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
   cv::Mat1b changed;
   cv::cvtColor(shader.shadingDifference(h) != 0.0f, changed, cv::COLOR_BGR2GRAY);
   EXPECT_EQ(cv::countNonZero(changed & ~touched), 0);
@@ -189,26 +254,30 @@ void expectLedSides(const SensorModel& model, const DigitShader& shader, const c
     EXPECT_GT(near_mean, 0.0) << led.name;
     EXPECT_GT(near_mean, far_mean + 5.0) << led.name;
   }
-  // And in the final frame: the top-left of the press is redder than its top-right.
+  // And in the final frame: as on real units, the top-right of the press is redder than its
+  // top-left, and the top-left greener.
   const cv::Mat3f frame_diff = difference(shader.shade(h, -1), shader.background());
   const cv::Rect box = cv::boundingRect(contact);
   const cv::Rect top_left(box.x, box.y, box.width / 2, box.height / 2);
   const cv::Rect top_right(box.x + box.width / 2, box.y, box.width / 2, box.height / 2);
-  EXPECT_GT(cv::mean(frame_diff(top_left))[2], cv::mean(frame_diff(top_right))[2] + 5.0);
-  EXPECT_GT(cv::mean(frame_diff(top_right))[1], cv::mean(frame_diff(top_left))[1] + 5.0);
+  EXPECT_GT(cv::mean(frame_diff(top_right))[2], cv::mean(frame_diff(top_left))[2] + 5.0);
+  EXPECT_GT(cv::mean(frame_diff(top_left))[1], cv::mean(frame_diff(top_right))[1] + 5.0);
 }
 
-TEST_F(ShaderTest, EachLedLightsTheSideOfAPressFacingIt) {
-  expectLedSides(model, shader, sphericalCap(model, 3.0, 0.5));
+TEST(ShaderLedTest, EachLedLightsTheSideOfAPressFacingIt) {
+  const SensorModel analytic = analyticModel();
+  expectLedSides(analytic,
+                 DigitShader(analytic, makeSyntheticBackground(analytic.imageSize()), kSynthetic),
+                 sphericalCap(analytic, 3.0, 0.5));
 }
 
 TEST(ShaderLedTest, EachLedLightsTheSideFacingItAtVgaAndOnADome) {
-  const SensorModel vga = makeDigitSensorModel(true);
-  expectLedSides(vga, DigitShader(vga, makeSyntheticBackground(vga.imageSize())),
+  const SensorModel vga = analyticModel(true);
+  expectLedSides(vga, DigitShader(vga, makeSyntheticBackground(vga.imageSize()), kSynthetic),
                  sphericalCap(vga, 3.0, 0.5));
-  SensorModel dome = makeDigitSensorModel();
+  SensorModel dome = analyticModel();
   dome.gel_curvature_radius_mm = 100.0;
-  const DigitShader dome_shader(dome, makeSyntheticBackground(dome.imageSize()));
+  const DigitShader dome_shader(dome, makeSyntheticBackground(dome.imageSize()), kSynthetic);
   EXPECT_TRUE(identical(dome_shader.shade(cv::Mat1f(dome.rows, dome.cols, 0.0f), -1),
                         dome_shader.background()));
   expectLedSides(dome, dome_shader, sphericalCap(dome, 3.0, 0.5));
@@ -217,7 +286,10 @@ TEST(ShaderLedTest, EachLedLightsTheSideFacingItAtVgaAndOnADome) {
 // A ball of 8.8 mm pressed 1.5 mm: real DIGIT presses of such a ball differ from the
 // background by ~29 grey levels on average inside the contact (95th percentile ~48) and by
 // little away from it.
-TEST_F(ShaderTest, BallPressHasRealisticMagnitudes) {
+TEST(ShaderLedTest, AnalyticBallPressHasRealisticMagnitudes) {
+  const SensorModel model = analyticModel();
+  const cv::Mat3b background = makeSyntheticBackground(model.imageSize());
+  const DigitShader shader(model, background, kSynthetic);
   const cv::Mat1f raw = sphericalCap(model, 4.4, 1.5);
   const cv::Mat1f h = smoothed(raw, model, 0.3);
   const cv::Mat3f diff = difference(shader.shade(h, -1), background);
@@ -238,7 +310,7 @@ TEST_F(ShaderTest, BallPressHasRealisticMagnitudes) {
 TEST_F(ShaderTest, SlopesAreScaleInvariantAcrossResolutions) {
   // The same press at VGA (half the mm per pixel) looks the same: slopes use mm over mm.
   const SensorModel vga = makeDigitSensorModel(true);
-  const DigitShader vga_shader(vga, makeSyntheticBackground(vga.imageSize()));
+  const DigitShader vga_shader(vga, makeSyntheticBackground(vga.imageSize()), kSynthetic);
   const cv::Mat1f qvga_raw = sphericalCap(model, 4.4, 1.0), vga_raw = sphericalCap(vga, 4.4, 1.0);
   const double qvga_mean =
       meanAbs(shader.shadingDifference(smoothed(qvga_raw, model, 0.3)), qvga_raw > 0.0f);
@@ -250,23 +322,125 @@ TEST_F(ShaderTest, SlopesAreScaleInvariantAcrossResolutions) {
 TEST_F(ShaderTest, ShadingGainScalesTheDifference) {
   const cv::Mat1f h = smoothed(sphericalCap(model, 3.0, 0.5), model, 0.2);
   SensorModel doubled = model, off = model;
-  doubled.shading_gain = 2.0;
-  off.shading_gain = 0.0;
+  doubled.shading.gain = 2.0;
+  off.shading.gain = 0.0;
   const cv::Mat3f base = shader.shadingDifference(h);
-  const cv::Mat3f twice = DigitShader(doubled, background).shadingDifference(h);
+  const cv::Mat3f twice = DigitShader(doubled, background, kSynthetic).shadingDifference(h);
   EXPECT_LT(cv::norm(twice, 2.0 * base, cv::NORM_INF), 1e-3);
   EXPECT_GT(cv::norm(base, cv::NORM_INF), 10.0);
-  EXPECT_TRUE(identical(DigitShader(off, background).shade(h, -1), background));
+  EXPECT_TRUE(identical(DigitShader(off, background, kSynthetic).shade(h, -1), background));
 }
 
 TEST_F(ShaderTest, ContactAtTheImageBorderIsHandled) {
   // A press cut by the image corner: one-sided differences, no out-of-range access.
-  const cv::Mat1f h = sphericalCap(model, 4.0, 1.0, -9.6, -12.8);
+  const cv::Mat1f h =
+      sphericalCap(model, 4.0, 1.0, -0.5 * model.gelWidthMm(), -0.5 * model.gelHeightMm());
   const cv::Mat3f diff = shader.shadingDifference(h);
   EXPECT_TRUE(cv::checkRange(diff));
   EXPECT_GT(cv::norm(diff(cv::Rect(0, 0, 10, 10)), cv::NORM_INF), 1.0);
   const cv::Mat3b image = shader.shade(h, 9);
   EXPECT_EQ(image.size(), model.imageSize());
+}
+
+// --- calibrated response ---------------------------------------------------------------------
+
+// On H = a - b (x^2 + y^2) (mm) central differences are exact: slope_x = -2 b x, slope_y =
+// -2 b y; a Gaussian blur of sigma s turns x^2 into x^2 + s^2, so B - H = -2 b s^2 (all of it in
+// rim_in) and B's slopes equal H's away from the image border.
+TEST(ShaderResponseTest, FeaturesOfAParaboloidMatchItsDerivatives) {
+  const SensorModel model = makeDigitSensorModel();
+  const double a = 3.0, b = 0.05, sigma = model.shading.shadow_sigma_mm;
+  cv::Mat1f h(model.rows, model.cols);
+  for (int r = 0; r < model.rows; ++r) {
+    for (int c = 0; c < model.cols; ++c) {
+      const cv::Point2d p = model.pixelToGelMm(r, c);
+      h(r, c) = static_cast<float>(a - b * (p.x * p.x + p.y * p.y));
+    }
+  }
+  ShadingFeatureArray f;
+  const cv::Rect box(0, 0, model.cols, model.rows);
+  computeShadingFeatures(h, model.mm_per_pixel, sigma, box, f);
+  const int margin = shadingReachPixels(model.mm_per_pixel, sigma) + 2;
+  double worst_slope = 0.0, worst_rim = 0.0, worst_blur_slope = 0.0;
+  for (int r = margin; r < model.rows - margin; r += 3) {
+    for (int c = margin; c < model.cols - margin; c += 3) {
+      const cv::Point2d p = model.pixelToGelMm(r, c);
+      const auto at = [&](int j) { return static_cast<double>(f[j](r, c)); };
+      const double gx = -2 * b * p.x, gy = -2 * b * p.y;
+      const double u = (c + 0.5) / (0.5 * model.cols) - 1.0,
+                   v = (r + 0.5) / (0.5 * model.rows) - 1.0;
+      worst_slope =
+          std::max({worst_slope, std::abs(at(0) - gx), std::abs(at(1) - gy),
+                    std::abs(at(2) - gx * gx), std::abs(at(3) - gx * gy), std::abs(at(4) - gy * gy),
+                    std::abs(at(5) - static_cast<double>(h(r, c))), std::abs(at(12) - gx * u),
+                    std::abs(at(15) - gy * v)});
+      worst_rim = std::max({worst_rim, std::abs(at(7) + 2 * b * sigma * sigma), std::abs(at(6))});
+      // rim_right - rim_left = dB/dx, rim_down - rim_up = dB/dy.
+      worst_blur_slope = std::max({worst_blur_slope, std::abs(at(8) - at(9) - gx),
+                                   std::abs(at(10) - at(11) - gy), std::abs(at(16) - at(8) * u)});
+    }
+  }
+  EXPECT_LT(worst_slope, 1e-4);
+  EXPECT_LT(worst_rim, 0.05 * 2 * b * sigma * sigma);  // the reduced-resolution blur
+  EXPECT_LT(worst_blur_slope, 0.02 * 2 * b * 6.0);     // 2 % of the largest slope
+}
+
+// The shader applies exactly the response: a unit coefficient on one feature reproduces that
+// feature in that channel, the others stay 0; the response is linear.
+TEST(ShaderResponseTest, ShaderAppliesTheResponseToTheFeatures) {
+  SensorModel model = makeDigitSensorModel();
+  const cv::Mat3b background = makeSyntheticBackground(model.imageSize());
+  const cv::Mat1f h = smoothed(sphericalCap(model, 3.0, 0.4, 1.0, 2.0), model, 0.2);
+  ShadingFeatureArray f;
+  const cv::Rect box(0, 0, model.cols, model.rows);
+  computeShadingFeatures(h, model.mm_per_pixel, model.shading.shadow_sigma_mm, box, f);
+  for (const int feature : {0, 4, 6, 10, 19}) {
+    model.shading.response_bgr = {};
+    model.shading.response_bgr[2][feature] = 1.0;
+    const cv::Mat3f diff = DigitShader(model, background, kSynthetic).shadingDifference(h);
+    std::vector<cv::Mat1f> planes;
+    cv::split(diff, planes);
+    EXPECT_LT(cv::norm(planes[2], f[feature], cv::NORM_INF),
+              1e-4 * cv::norm(f[feature], cv::NORM_INF))
+        << feature;
+    EXPECT_GT(cv::norm(f[feature], cv::NORM_INF), 1e-3) << feature;
+    EXPECT_EQ(cv::norm(planes[0], cv::NORM_INF) + cv::norm(planes[1], cv::NORM_INF), 0.0);
+  }
+}
+
+// The default (calibrated on a real unit) press of a 6 mm ball against what real DIGIT presses
+// measure on five units: blue brightens below (57-84 deg), green on the left (-146 to -163),
+// red at the upper right (-31 to -52); the darkest rim sector is 7-17 grey levels below the
+// background. Mean |diff| inside the contact: 25-43 on those units, 23-24 on the calibration
+// unit's own held-out presses. Checked at three places on the gel, for a 1.5 mm contact radius
+// (typical of the calibration set).
+TEST(ShaderResponseTest, CalibratedBallPressLooksLikeARealOne) {
+  const SensorModel model = makeDigitSensorModel();
+  const DigitShader shader(model, makeSyntheticBackground(model.imageSize()), kSynthetic);
+  const GelModel gel_model(model);
+  for (const cv::Point2d centre_mm : {cv::Point2d(0, 0), cv::Point2d(-2, 3), cv::Point2d(2, -3)}) {
+    const double ball = 3.0, contact = 1.5;
+    const double depth = ball - std::sqrt(ball * ball - contact * contact);
+    cv::Mat1f gel;
+    gel_model.apply(sphericalCap(model, ball, depth, centre_mm.x, centre_mm.y), gel);
+    PressObservation press;
+    press.diff = shader.shadingDifference(gel);
+    press.circle.centre_px = {(centre_mm.x / model.mm_per_pixel) + 0.5 * model.cols - 0.5,
+                              (centre_mm.y / model.mm_per_pixel) + 0.5 * model.rows - 0.5};
+    press.circle.radius_px = contact / model.mm_per_pixel;
+    // compareWithReal's measures of the press itself (against an all-zero "simulation").
+    const FitQuality q = compareWithReal({press}, {cv::Mat3f(press.diff.size(), cv::Vec3f())},
+                                         {press.circle.radius_px});
+    const std::string where =
+        "centre " + std::to_string(centre_mm.x) + ", " + std::to_string(centre_mm.y) + " mm";
+    EXPECT_NEAR(q.real_side_deg[0], 70.0, 14.0 + 15.0) << "blue, " << where;
+    EXPECT_NEAR(q.real_side_deg[1], -154.0, 9.0 + 15.0) << "green, " << where;
+    EXPECT_NEAR(q.real_side_deg[2], -41.0, 11.0 + 15.0) << "red, " << where;
+    EXPECT_LT(q.real_rim_darkest, -3.5) << where;  // at least half the least real shadow
+    EXPECT_GT(q.real_rim_darkest, -25.0) << where;
+    EXPECT_GT(q.real_contact_mean, 0.5 * 23.0) << where;
+    EXPECT_LT(q.real_contact_mean, 1.3 * 43.0) << where;
+  }
 }
 
 // --- synthetic background ------------------------------------------------------------------
@@ -339,12 +513,14 @@ TEST(BackgroundTest, SyntheticBackgroundWorksAtVgaAndMatchesQvga) {
 // --- bad input and loading -----------------------------------------------------------------
 
 TEST_F(ShaderTest, RejectsBackgroundAndHeightOfTheWrongSize) {
-  EXPECT_THROW(DigitShader(model, cv::Mat3b()), Error);
-  EXPECT_THROW(DigitShader(model, makeSyntheticBackground({320, 240})), Error);  // landscape
-  EXPECT_THROW(DigitShader(model, makeSyntheticBackground({480, 640})), Error);
+  EXPECT_THROW(DigitShader(model, cv::Mat3b(), kSynthetic), Error);
+  EXPECT_THROW(DigitShader(model, makeSyntheticBackground({320, 240}), kSynthetic),
+               Error);  // landscape
+  EXPECT_THROW(DigitShader(model, makeSyntheticBackground({480, 640}), kSynthetic), Error);
   SensorModel broken = model;
-  broken.noise_sigma = -1.0;
-  EXPECT_TRUE(messageContains([&] { const DigitShader bad(broken, background); }, "noise_sigma"));
+  broken.noise.sigma_bgr[1] = -1.0;
+  EXPECT_TRUE(messageContains([&] { const DigitShader bad(broken, background, kSynthetic); },
+                              "noise.sigma_bgr"));
   EXPECT_THROW(shader.shade(cv::Mat1f(10, 10, 0.0f), -1), Error);
   EXPECT_THROW(shader.shade(cv::Mat1f(), -1), Error);
   EXPECT_THROW(shader.shadingDifference(cv::Mat1f(240, 320, 0.0f)), Error);
@@ -360,7 +536,7 @@ TEST_F(ShaderTest, RejectsBackgroundAndHeightOfTheWrongSize) {
 
 TEST_F(ShaderTest, KeepsItsOwnCopyOfTheBackground) {
   cv::Mat3b mine = background.clone();
-  const DigitShader own(model, mine);
+  const DigitShader own(model, mine, kSynthetic);
   mine.setTo(cv::Scalar(0, 0, 0));
   EXPECT_TRUE(identical(own.shade(flat, -1), background));
 }
@@ -397,7 +573,8 @@ TEST(BackgroundTest, LoadsGray16BitBgraAndResizes) {
 
   // A loaded background drives the shader.
   const SensorModel model = makeDigitSensorModel();
-  const DigitShader shader(model, loadBackground(dir.path("vga.png"), model.imageSize()));
+  const DigitShader shader(model, loadBackground(dir.path("vga.png"), model.imageSize()),
+                           BackgroundSource::kCaptured);
   EXPECT_TRUE(identical(shader.shade(cv::Mat1f(model.rows, model.cols, 0.0f), -1), loaded));
 }
 

@@ -13,6 +13,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
@@ -90,7 +91,10 @@ TEST(RealTime, TfJointStatesAndContactsPublishWithOneStamp) {
     EXPECT_NEAR(c.max_indentation, 1e-3, 0.02e-3);
     EXPECT_NEAR(c.normal_force, 12.85, 0.5);             // the gel law at 1 mm
     EXPECT_NEAR(c.shear_force.y, 0.1 * 9.81 / 2, 0.05);  // each gel carries half the cube
-    EXPECT_NEAR(c.contact_area, 0.0192 * 0.0256, 1e-6);  // the cube face covers the gel
+    // The cube face covers the gel pad, which is the shipped sensor's imaged area.
+    const norm2tex::SensorModel sensor =
+        norm2tex::loadSensorModel(NORM2TEX_SOURCE_DIR "/config/digit.yaml");
+    EXPECT_NEAR(c.contact_area, sensor.gelWidthMm() * sensor.gelHeightMm() * 1e-6, 1e-6);
   }
 }
 

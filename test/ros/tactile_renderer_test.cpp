@@ -21,10 +21,15 @@
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
+#include "norm2tex/render/digit_shader_response.hpp"
+#include "norm2tex/render/sensor_model.hpp"
 #include "run_node.hpp"
 #include "wait_for.hpp"
 
 namespace {
+
+// The sensor the sync rostests launch (tactile_renderer_sync.test).
+const char* const kSensorYaml = NORM2TEX_SOURCE_DIR "/config/digit.yaml";
 
 using norm2tex::waitFor;
 
@@ -287,13 +292,30 @@ TEST(SynchronousRendering, MaterialChangesTextureNotContactAndBetaZeroIsTexturel
   const cv::Scalar inside = cv::mean(diff, mask("digit_left"));
   EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 1.0);
   // ... and the very same pixels far from it (beyond the gel's skirt).
+  // Beyond the gel's skirt (3 sigma of its smoothing pyramid) and the shading's reach (its
+  // rim-shadow blur), in pixels of the shipped sensor.
+  const norm2tex::SensorModel sensor = norm2tex::loadSensorModel(kSensorYaml);
+  double variance_mm2 = 0.0;
+  for (const double sigma : sensor.gel.pyramid_sigmas_mm) variance_mm2 += sigma * sigma;
+  const int far_px =
+      static_cast<int>(std::ceil(3.0 * std::sqrt(variance_mm2) / sensor.mm_per_pixel)) +
+      norm2tex::shadingReachPixels(sensor.mm_per_pixel, sensor.shading.shadow_sigma_mm) + 8;
   cv::Mat near;
-  cv::dilate(mask("digit_left"), near, cv::Mat(), cv::Point(-1, -1),
-             80);  // 6 x the gel's 1 mm blur
+  cv::dilate(mask("digit_left"), near, cv::Mat(), cv::Point(-1, -1), far_px);
   cv::Mat far;
   cv::bitwise_not(near, far);
-  ASSERT_GT(cv::countNonZero(far), 1000);
-  EXPECT_EQ(cv::mean(diff, far)[0], 0.0);
+  if (cv::countNonZero(far) >= 1000) {
+    EXPECT_EQ(cv::mean(diff, far)[0], 0.0);
+  } else {
+    // At the shipped scale (0.0532 mm/px, a 13 x 17 mm view) the held cube's contact, skirt and
+    // rim-shadow reach can cover the whole frame: then the material must show much less
+    // outside the contact than inside it.
+    cv::Mat outside;
+    cv::bitwise_not(mask("digit_left"), outside);
+    ASSERT_GT(cv::countNonZero(outside), 500);
+    const cv::Scalar out = cv::mean(diff, outside);
+    EXPECT_LT((out[0] + out[1] + out[2]) / 3.0, 0.5 * (inside[0] + inside[1] + inside[2]) / 3.0);
+  }
   // beta 0 renders exactly what no texture renders; with texture the contact differs.
   EXPECT_EQ(cv::norm(image("digit_left_plain"), image("digit_left_bare"), cv::NORM_INF), 0.0);
   EXPECT_GT(cv::norm(image("digit_left"), image("digit_left_bare"), cv::NORM_INF), 2.0);
@@ -302,8 +324,10 @@ TEST(SynchronousRendering, MaterialChangesTextureNotContactAndBetaZeroIsTexturel
 TEST(SynchronousRendering, AOneMillimetreSlideShiftsTheTextureByOneMillimetre) {
   SyncFixture f;
   ASSERT_TRUE(f.ready());
-  // The cube 1 mm higher = 1 mm towards the image top: 1 / 0.08 = 12.5 pixels.
-  std::vector<cv::Mat> crops;
+  // The cube 1 mm higher = 1 mm towards the image top: 1 / mm_per_pixel pixels of the shipped
+  // sensor (18.8 at its 0.0532 mm/px).
+  const double pixels_per_mm = 1.0 / norm2tex::loadSensorModel(kSensorYaml).mm_per_pixel;
+  std::vector<cv::Mat> reliefs;
   for (double offset : {0.000, 0.001}) {
     norm2tex::Reset episode;
     episode.request.seed = 3;
@@ -311,16 +335,38 @@ TEST(SynchronousRendering, AOneMillimetreSlideShiftsTheTextureByOneMillimetre) {
     ASSERT_TRUE(f.reset.call(episode));
     const ros::Time t = f.stepOnce();
     ASSERT_TRUE(f.imagesOf(t));
-    cv::Mat gray, textured, bare, relief;
+    cv::Mat textured, bare, relief;
     // Rock: random grains, so the correlation has one peak (wood's grain runs along the slide).
     cv::cvtColor(view(*f.l.log["digit_left_rock"].image[t]), textured, cv::COLOR_BGR2GRAY);
     cv::cvtColor(view(*f.l.log["digit_left_bare"].image[t]), bare, cv::COLOR_BGR2GRAY);
     // The texture alone: the textured frame minus the same frame without texture.
     cv::subtract(textured, bare, relief, cv::noArray(), CV_32F);
-    crops.push_back(relief(cv::Rect(40, 60, 160, 160)).clone());
+    reliefs.push_back(relief);
   }
-  const cv::Point2d shift = cv::phaseCorrelate(crops[0], crops[1]);
-  EXPECT_NEAR(shift.y, -12.5, 0.5);
+  // Where the first relief's centre crop lies in the second: normalised cross-correlation over
+  // shifts of up to 30 rows and 10 columns, the peak refined by a parabola. (Phase correlation
+  // whitens the spectrum, so with texture only a few grey levels deep, as the calibrated
+  // shading draws it like a real DIGIT, the 1-level rounding pattern outweighs the grains.)
+  const cv::Rect crop(40, 80, 160, 140);
+  const int reach_x = 10, reach_y = 30;
+  cv::Mat scores;
+  cv::matchTemplate(reliefs[1](cv::Rect(crop.x - reach_x, crop.y - reach_y,
+                                        crop.width + 2 * reach_x, crop.height + 2 * reach_y)),
+                    reliefs[0](crop), scores, cv::TM_CCOEFF_NORMED);
+  cv::Point peak;
+  double best = 0.0;
+  cv::minMaxLoc(scores, nullptr, &best, nullptr, &peak);
+  EXPECT_GT(best, 0.5) << "the texture is found again";
+  const auto refine = [&](int at, int size, const std::function<float(int)>& score) {
+    if (at <= 0 || at >= size - 1) return static_cast<double>(at);
+    const double left = score(at - 1), centre = score(at), right = score(at + 1);
+    const double curvature = left - 2.0 * centre + right;
+    return at + (curvature < 0.0 ? 0.5 * (left - right) / curvature : 0.0);
+  };
+  const cv::Point2d shift(
+      refine(peak.x, scores.cols, [&](int x) { return scores.at<float>(peak.y, x); }) - reach_x,
+      refine(peak.y, scores.rows, [&](int y) { return scores.at<float>(y, peak.x); }) - reach_y);
+  EXPECT_NEAR(shift.y, -pixels_per_mm, 0.5);
   EXPECT_NEAR(shift.x, 0.0, 0.5);
 }
 

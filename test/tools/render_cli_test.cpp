@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli_runner.hpp"
+#include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 
@@ -53,7 +54,8 @@ TEST_F(RenderCli, WritesImageDepthAndMask) {
   ASSERT_EQ(mask.type(), CV_8UC1);
   const cv::Moments m = cv::moments(mask, true);
   ASSERT_GT(m.m00, 1000);
-  EXPECT_NEAR(m.m10 / m.m00, 119.5 + 2.0 / 0.08, 1.5) << "x = +2 mm is right of centre";
+  const double mm_per_pixel = norm2tex::makeDigitSensorModel().mm_per_pixel;  // no --sensor
+  EXPECT_NEAR(m.m10 / m.m00, 119.5 + 2.0 / mm_per_pixel, 1.5) << "x = +2 mm is right of centre";
 }
 
 TEST_F(RenderCli, SheetHasOneRowPerTextureAndOneColumnPerPress) {

@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "norm2tex/render/digit_shader_noise.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 
 namespace norm2tex {
@@ -26,36 +27,35 @@ cv::Mat3b makeSyntheticBackground(cv::Size size);
 /// landscape frame for a portrait sensor (or the reverse): a frame the driver did not rotate.
 cv::Mat3b loadBackground(const std::string& path, cv::Size size);
 
-/// Turns the gel's final indentation into a DIGIT image.
+/// Where a background comes from: a captured frame already carries the sensor's noise.
+enum class BackgroundSource { kSynthetic, kCaptured };
+
+/// Turns the gel's final deformation into a DIGIT image:
+///   image = background + shading difference + noise     (rounded, clipped to bgr8)
 ///
-/// Shading model. The membrane surface is z(x, y) = dome(x, y) - H(x, y) (gel frame, mm;
-/// dome = 0 for a flat gel), so indentation moves it towards the camera. Its slopes come from
-/// central differences of H_final in consistent units (dH in mm over mm_per_pixel per pixel;
-/// one-sided at the image border). The LEDs light the membrane's inner side, whose normal is
-/// n = (dz/dx, dz/dy, -1) / |.|. Each LED i, seen from the pixel's point on the undeformed
-/// surface along the unit vector l_i, contributes
-///   colour_i * intensity_i * w_i * max(0, n . l_i),   w_i = |LED_i| / |LED_i - p|
-/// (Lambertian with a mild 1/d fall-off, 1 at the gel centre). Because the LEDs sit at grazing
-/// angles behind the surface, a slope of an indentation facing an LED catches more of its light:
-/// the top-left side of a press turns redder, the top-right greener, the bottom bluer.
-///   x     = 360 * (shading(H) - shading(undeformed gel))      per channel, grey levels
-///   image = background + shading_gain * x / (1 + |x| / 70) + noise
-/// The soft knee (linear for small slopes, saturating towards 70 grey levels on steep ones)
-/// reproduces real presses, which show colour across the whole contact rather than only a
-/// bright rim: an 8.8 mm ball pressed 1.5 mm (after GelModel) gives a mean |frame -
-/// background| of 29 grey levels inside the contact and a 95th percentile of 48, as measured
-/// on real DIGIT ball presses (linear shading at the same mean gives a 95th percentile of 74).
+/// Shading (SensorModel::shading.kind):
+/// - calibrated (default): the signed per-channel response to the gel's slopes, depth and rim
+///   of digit_shader_response.hpp, fitted to a real sensor by norm2tex_calibrate. It brightens
+///   and darkens (a dark shadow crescent just outside the contact rim), colouring a press like
+///   a smooth hue wheel as real units do.
+/// - analytic_leds: the earlier analytic model. The membrane surface is z = dome - H; its
+///   inner normal n = (dz/dx, dz/dy, -1) / |.|; each LED i, seen from the pixel along l_i,
+///   contributes colour_i * intensity_i * w_i * max(0, n . l_i), w_i = |LED_i| / |LED_i - p|;
+///     x = 205 * (shading(H) - shading(undeformed gel)),  diff = gain * x / (1 + |x| / 300).
+///   It can only add light (no shadows) and draws three saturated sectors.
 ///
-/// Cost. Shading is computed only in the bounding box of the pixels with H != 0, grown by 2 px;
-/// elsewhere the output is the background (+ noise) bit for bit. Noise is Gaussian with sigma
-/// = noise_sigma, drawn over the whole frame in raster order from the seed with xoshiro256**
-/// and a 4096-entry inverse-CDF table (five samples per 64-bit draw): fresh per frame,
-/// identical for the same seed, cheap. It is added last and the result rounded and clipped to
-/// bgr8. Thread-safe: shade() keeps no state between calls.
+/// Cost. Shading is computed only in the bounding box of the pixels with H != 0, grown by the
+/// shading's reach; elsewhere the output is the background (+ noise) bit for bit.
+///
+/// Noise (DigitShaderNoise): none on a captured background unless
+/// noise.on_real_background, since the frame already carries the sensor's own noise; on a
+/// synthetic background, correlated per-channel noise drawn from the seed over the whole frame
+/// (a pixel's noise depends only on the seed and its position). Thread-safe: shade() keeps no
+/// state between calls.
 class DigitShader {
  public:
   /// `background` must have the model's image size (CV_8UC3).
-  DigitShader(const SensorModel& model, cv::Mat3b background);
+  DigitShader(const SensorModel& model, cv::Mat3b background, BackgroundSource source);
 
   /// `h_final_mm` CV_32FC1 of image size, indentation in mm (>= 0 into the gel), finite. With
   /// `noise_seed` < 0 no noise is added; otherwise the noise is drawn from that seed. Throws
@@ -66,13 +66,19 @@ class DigitShader {
   cv::Mat3f shadingDifference(const cv::Mat1f& h_final_mm) const;
 
   const cv::Mat3b& background() const { return background_; }
+  /// Whether shade() with a seed >= 0 adds noise (see the class comment).
+  bool addsNoise() const { return noise_.enabled() && adds_noise_; }
+  /// How far (pixels) beyond the deformed pixels the shading difference can be non-zero.
+  int reachPixels() const { return reach_px_; }
 
  private:
   void checkHeight(const cv::Mat1f& h_final_mm) const;
   /// Pixels with H != 0, grown by the stencil margin and clipped; empty if there are none.
   cv::Rect contactBox(const cv::Mat1f& h) const;
-  /// shading(H) - shading(flat) for the pixels of `box`, into `diff` (box-sized).
+  /// The shading difference for the pixels of `box`, into `diff` (box-sized).
   void shadeBox(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& diff) const;
+  /// analytic_leds: shading(H) - shading(flat) for the pixels of `box`.
+  void shadeBoxAnalytic(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& diff) const;
 
   SensorModel model_;
   cv::Mat3b background_;
@@ -84,7 +90,9 @@ class DigitShader {
   std::array<cv::Mat1f, 3> flat_planes_;
   std::array<cv::Mat1f, 2> dome_planes_;
   std::array<cv::Vec3f, 3> led_colours_;  // colour * intensity * shading scale
-  std::vector<float> noise_table_;        // sigma * normal quantiles; empty if sigma == 0
+  DigitShaderNoise noise_;
+  bool adds_noise_ = true;  // false on a captured background (unless asked for)
+  int reach_px_ = 2;
 };
 
 }  // namespace norm2tex

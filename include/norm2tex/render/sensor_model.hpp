@@ -16,10 +16,46 @@ struct LedModel {
   double intensity = 1.0;  ///< relative, >= 0
 };
 
+/// Which shading model DigitShader uses.
+enum class ShadingKind {
+  kCalibrated,   ///< signed response to the gel's slopes, depth and rim (DigitShaderResponse)
+  kAnalyticLeds  ///< the earlier analytic model: clamped Lambertian terms of three LEDs
+};
+
+/// Number of per-pixel features of the calibrated response (see digit_shader_response.hpp).
+constexpr int kShadingFeatureCount = 24;
+
+/// The shading stage's options (DigitShader).
+struct ShadingOptions {
+  ShadingKind kind = ShadingKind::kCalibrated;
+  double gain = 1.0;  ///< multiplies the shading difference before the background is added
+  /// Calibrated response: grey levels per unit of each feature, one row per channel (B, G, R),
+  /// features in the order of digit_shader_response.hpp. Defaults: fitted by
+  /// norm2tex_calibrate on the MIT calibration set of one real DIGIT (see config/digit.yaml).
+  std::array<std::array<double, kShadingFeatureCount>, 3> response_bgr{};
+  /// Width (mm) of the blur whose spill past the contact rim carries the rim-shadow features.
+  double shadow_sigma_mm = 0.6;
+};
+
+/// Pixel noise added to a frame. A captured background already carries the sensor's noise, so
+/// by default nothing is added on top of one; a synthetic (noise-free) background gets noise
+/// with the per-channel sigma and the spatial and cross-channel correlations measured on real
+/// DIGIT frames.
+struct NoiseOptions {
+  cv::Vec3d sigma_bgr{2.8, 1.5, 2.5};  ///< grey levels (of 255), per channel, OpenCV order
+  double neighbour_correlation = 0.6;  ///< between horizontally / vertically adjacent pixels
+  double correlation_bg = -0.33;       ///< between the blue and green noise of one pixel
+  double correlation_gr = -0.42;       ///< green and red
+  double correlation_br = 0.0;         ///< blue and red
+  bool on_real_background = false;     ///< add noise on top of a captured background too
+};
+
 /// Elastomer smoothing (see GelModel): Taxim-style pyramid of Gaussian blurs that restores the
 /// contact core after each level, then one small blur.
 struct GelOptions {
-  std::vector<double> pyramid_sigmas_mm = {1.0, 0.5, 0.25, 0.1};  ///< coarse to fine (Taxim)
+  /// Coarse to fine. Real DIGIT presses fall from 80 % to 20 % of their shading over 0.29-0.36
+  /// contact radii at the rim; Taxim's 1.0 mm level gives 0.42-0.45 at the measured scale.
+  std::vector<double> pyramid_sigmas_mm = {0.5, 0.25, 0.1};
   double core_fraction = 0.4;   ///< pixels indented more than this x max indentation: the core
   double final_sigma_mm = 0.1;  ///< last blur over everything
 };
@@ -34,17 +70,25 @@ struct GelOptions {
 struct SensorModel {
   int rows = 320;                 ///< image height, pixels (portrait QVGA as drivers publish)
   int cols = 240;                 ///< image width, pixels
-  double mm_per_pixel = 0.08;     ///< gel millimetres per pixel at the gel surface
+  /// Gel millimetres per pixel at the gel surface. Four calibrations of real units measure
+  /// 17-19.6 px/mm at QVGA; the default, 0.054, is the calibration set's unit (18.5 px/mm).
+  double mm_per_pixel = 0.054;
   double gel_thickness_mm = 4.6;  ///< indentation is clamped to this
+  /// The physical gel pad, which the gripper physics presses against (setGelFromSensor). The
+  /// camera sees only its middle (gelWidthMm() x gelHeightMm(), about 13 x 17 mm at the
+  /// measured scale); quoted DIGIT gels are 18.35 x 24.6 to 20 x 30 mm.
+  double gel_pad_width_mm = 19.2;
+  double gel_pad_height_mm = 25.6;
   double gel_curvature_radius_mm = 0.0;  ///< 0 = flat gel; else a dome of this radius
   double fx = 277.1, fy = 277.1;         ///< camera_info intrinsics, pixels
   double cx = 119.5, cy = 159.5;         ///< principal point, pixels
-  std::array<LedModel, 3> leds;          ///< red, green, blue
-  double shading_gain = 1.0;     ///< scales (shading - flat shading) before adding background
-  double noise_sigma = 2.0;      ///< Gaussian pixel noise, grey levels of 255
+  std::array<LedModel, 3> leds;          ///< red, green, blue (the analytic_leds shading)
+  ShadingOptions shading;
+  NoiseOptions noise;
   std::string background_image;  ///< user's no-contact frame (BGR); empty = synthetic
   GelOptions gel;
 
+  /// The imaged part of the gel (cols x mm_per_pixel by rows x mm_per_pixel).
   double gelWidthMm() const { return cols * mm_per_pixel; }
   double gelHeightMm() const { return rows * mm_per_pixel; }
   cv::Size imageSize() const { return {cols, rows}; }
@@ -57,8 +101,16 @@ SensorModel makeDigitSensorModel(bool vga = false);
 
 /// Loads config/digit.yaml (every key optional, defaults above; `preset: qvga|vga` first).
 /// A relative background_image is resolved against the yaml's directory. Throws Error naming
-/// the file and key for unreadable yaml or a value out of range.
+/// the file and key for unreadable yaml, an unknown key (a typo would otherwise be ignored
+/// silently) or a value out of range.
 SensorModel loadSensorModel(const std::string& yaml_path);
+
+/// Writes `model` as a sensor yaml that loadSensorModel reads back to the same model (every
+/// key written). `background_image` is written as given (make it relative to the yaml's
+/// directory to keep the pair movable). Throws Error naming the file if it cannot be written.
+void saveSensorModel(const SensorModel& model, const std::string& yaml_path);
+
+const char* shadingKindName(ShadingKind kind);
 
 /// Throws Error naming the first field out of range and its valid range.
 void validate(const SensorModel& model);

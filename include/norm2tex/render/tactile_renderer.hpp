@@ -36,9 +36,9 @@ struct TactileFrame {
 /// thread-safe (use one per thread or sensor).
 class TactileRenderer {
  public:
-  /// Background: the model's background_image if set, else the synthetic one.
+  /// Background: the model's background_image if set (captured), else the synthetic one.
   explicit TactileRenderer(const SensorModel& model);
-  TactileRenderer(const SensorModel& model, cv::Mat3b background);
+  TactileRenderer(const SensorModel& model, cv::Mat3b background, BackgroundSource source);
 
   /// The object to render. `atlas` may be null or `beta_mm` 0: textureless. Returns a warning
   /// (empty if none), e.g. when texture was asked for but the mesh has no UVs.

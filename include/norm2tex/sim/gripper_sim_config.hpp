@@ -66,13 +66,15 @@ struct GripperSimConfig {
   EpisodeOptions episode;
   GelLaw gel_law = GelLaw::taximDefault();
   /// Gel pad: width (along the gel frame's x), height (y) and thickness, metres: the sensor
-  /// model's imaged area and gel thickness (setGelFromSensor), so physics and image agree.
+  /// model's gel pad and thickness (setGelFromSensor). The camera images the pad's middle.
   double gel_width_m = 0.0192;
   double gel_height_m = 0.0256;
   double gel_thickness_m = 0.0046;
 };
 
-/// Sets the gel pad to the sensor's imaged area (cols x rows x mm_per_pixel) and thickness.
+/// Sets the gel pad to the sensor's (gel.pad_width_mm x pad_height_mm) and its thickness. The
+/// pad is larger than the imaged area (cols x rows x mm_per_pixel, about 13 x 17 mm at the
+/// measured scale): an object can rest on the gel outside the camera's view.
 void setGelFromSensor(const SensorModel& sensor, GripperSimConfig& config);
 
 /// Throws Error naming the first field out of range (its yaml key) and its valid range.

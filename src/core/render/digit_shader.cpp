@@ -9,14 +9,15 @@
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader_response.hpp"
 
 namespace norm2tex {
 namespace {
 
-// Response: x = kShadingScale * (shading(H) - shading(flat)) per channel, in grey levels per
-// unit of n . l, then a soft knee x / (1 + |x| / kKneeGreyLevels) and shading_gain. Fitted so
-// that a ball of 8.8 mm pressed 1.5 mm into the gel, through the GelModel, differs from the
-// background inside the contact by 32 grey levels on average with a 95th percentile of 44 and
+// analytic_leds response: x = kShadingScale * (shading(H) - shading(flat)) per channel, in grey
+// levels per unit of n . l, then a soft knee x / (1 + |x| / kKneeGreyLevels) and shading_gain.
+// Fitted so that a ball of 8.8 mm pressed 1.5 mm into the gel, through the GelModel, differs from
+// the background inside the contact by 32 grey levels on average with a 95th percentile of 44 and
 // a peak of 94; real DIGIT ball presses measure about 29 and 48. Our contact shading is more
 // uniform than a real one (48 / 29 = 1.65 there, 1.4 here), so mean and tail cannot both
 // match; a strong knee (70) matched the mean (30) but cut the tail to 36. The knee keeps steep
@@ -29,85 +30,13 @@ constexpr float kKneeGreyLevels = 300.0f;
 // LED 5x stronger than at the centre; 1/d keeps the LED-side emphasis mild (at most ~2.3x).
 constexpr double kFalloffExponent = 1.0;
 
-// Pixels whose shading is computed extend this far beyond the last non-zero indentation: the
-// central differences of a pixel next to the contact see it.
-constexpr int kBoxMargin = 2;
+// analytic_leds: pixels whose shading is computed extend this far beyond the last non-zero
+// indentation: the central differences of a pixel next to the contact see it.
+constexpr int kAnalyticReach = 2;
 
 // The per-pixel planes get this many spare columns so that the 4-wide SIMD loop may run past a
 // box's last column without a scalar tail.
 constexpr int kLanes = 4;
-
-// Noise: inverse-CDF table of the standard normal at 2^12 equally likely quantiles; one 64-bit
-// xoshiro256** draw yields five 12-bit indices, so a QVGA frame needs ~46k draws and table
-// lookups in L1 instead of 230k Box-Muller evaluations. Fresh noise every frame, identical for
-// the same seed (and, unlike std::normal_distribution, the same across standard libraries).
-// The table is preferred to a pool of precomputed frames, whose offsets would repeat the same
-// pattern shifted from frame to frame. Truncation at the extreme
-// quantiles (+-3.7 sigma) is invisible at grey-level noise; the table is rescaled to the
-// exact sigma.
-constexpr int kNoiseTableBits = 12;
-constexpr int kNoiseTableSize = 1 << kNoiseTableBits;
-constexpr int kSamplesPerDraw = 64 / kNoiseTableBits;
-
-std::uint64_t splitMix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-// xoshiro256** (Blackman and Vigna): fast, well distributed in all bits.
-class Xoshiro256 {
- public:
-  explicit Xoshiro256(std::uint64_t seed) {
-    for (std::uint64_t& word : s_) word = splitMix64(seed);
-  }
-  std::uint64_t next() {
-    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
-    const std::uint64_t t = s_[1] << 17;
-    s_[2] ^= s_[0];
-    s_[3] ^= s_[1];
-    s_[1] ^= s_[2];
-    s_[0] ^= s_[3];
-    s_[2] ^= t;
-    s_[3] = rotl(s_[3], 45);
-    return result;
-  }
-
- private:
-  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-  std::uint64_t s_[4];
-};
-
-// Standard normal quantile by Newton's method on the CDF, started at 0: the CDF is convex
-// below 0 and concave above, so the iteration approaches monotonically.
-double normalQuantile(double p) {
-  double x = 0.0;
-  for (int i = 0; i < 100; ++i) {
-    const double cdf = 0.5 * std::erfc(-x / std::sqrt(2.0));
-    const double pdf = std::exp(-0.5 * x * x) / std::sqrt(2.0 * 3.14159265358979323846);
-    const double step = (cdf - p) / pdf;
-    x -= step;
-    if (std::abs(step) < 1e-12) break;
-  }
-  return x;
-}
-
-std::vector<float> makeNoiseTable(double sigma) {
-  if (sigma <= 0.0) return {};
-  std::vector<double> z(kNoiseTableSize);
-  for (int k = 0; k < kNoiseTableSize / 2; ++k) {
-    z[k] = normalQuantile((k + 0.5) / kNoiseTableSize);
-    z[kNoiseTableSize - 1 - k] = -z[k];  // exactly symmetric: zero mean
-  }
-  double variance = 0.0;
-  for (double value : z) variance += value * value;
-  variance /= kNoiseTableSize;
-  std::vector<float> table(kNoiseTableSize);
-  const double scale = sigma / std::sqrt(variance);
-  for (int k = 0; k < kNoiseTableSize; ++k) table[k] = static_cast<float>(z[k] * scale);
-  return table;
-}
 
 // Lambertian shading of the membrane's inner side with slopes (dz/dx, dz/dy) of the surface
 // z(x, y): inner normal (dz/dx, dz/dy, -1) / |.|, towards the camera and the LEDs.
@@ -125,9 +54,12 @@ inline cv::Vec3f shadePixel(float dzdx, float dzdy, const cv::Vec3f* lights,
 
 }  // namespace
 
-DigitShader::DigitShader(const SensorModel& model, cv::Mat3b background)
-    : model_(model), background_(std::move(background)) {
-  validate(model_);
+DigitShader::DigitShader(const SensorModel& model, cv::Mat3b background, BackgroundSource source)
+    : model_((validate(model), model)), background_(std::move(background)), noise_(model.noise) {
+  adds_noise_ = source == BackgroundSource::kSynthetic || model_.noise.on_real_background;
+  reach_px_ = model_.shading.kind == ShadingKind::kCalibrated
+                  ? shadingReachPixels(model_.mm_per_pixel, model_.shading.shadow_sigma_mm)
+                  : kAnalyticReach;
   if (background_.empty() || background_.type() != CV_8UC3) {
     throw Error("DigitShader: background image is empty or not 8-bit BGR (CV_8UC3)");
   }
@@ -181,7 +113,6 @@ DigitShader::DigitShader(const SensorModel& model, cv::Mat3b background)
       for (int k = 0; k < 3; ++k) flat_planes_[k](r, c) = flat[k];
     }
   }
-  noise_table_ = makeNoiseTable(model_.noise_sigma);
 }
 
 void DigitShader::checkHeight(const cv::Mat1f& h_final_mm) const {
@@ -207,12 +138,24 @@ cv::Rect DigitShader::contactBox(const cv::Mat1f& h) const {
     right = std::max(right, last);
   }
   if (bottom < 0) return {};
-  const cv::Rect box(left - kBoxMargin, top - kBoxMargin, right - left + 1 + 2 * kBoxMargin,
-                     bottom - top + 1 + 2 * kBoxMargin);
+  const cv::Rect box(left - reach_px_, top - reach_px_, right - left + 1 + 2 * reach_px_,
+                     bottom - top + 1 + 2 * reach_px_);
   return box & cv::Rect(0, 0, h.cols, h.rows);
 }
 
 void DigitShader::shadeBox(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& diff) const {
+  if (model_.shading.kind == ShadingKind::kAnalyticLeds) {
+    shadeBoxAnalytic(h, box, diff);
+    return;
+  }
+  // NaN or infinity anywhere in the box would spread through the features.
+  if (!cv::checkRange(h(box))) {
+    throw Error("DigitShader: h_final_mm contains NaN or infinite values");
+  }
+  computeShadingDifference(h, model_.mm_per_pixel, model_.shading, box, diff);
+}
+
+void DigitShader::shadeBoxAnalytic(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& diff) const {
   // Slopes in consistent units: dH (mm) over the pixel spacing (mm).
   const float inv_pixel = static_cast<float>(1.0 / model_.mm_per_pixel);
   const int last_row = h.rows - 1, last_col = h.cols - 1;
@@ -222,7 +165,7 @@ void DigitShader::shadeBox(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& d
 
   using cv::v_float32x4;
   const v_float32x4 zero = cv::v_setzero_f32(), one = cv::v_setall_f32(1.0f);
-  const v_float32x4 gain = cv::v_setall_f32(static_cast<float>(model_.shading_gain));
+  const v_float32x4 gain = cv::v_setall_f32(static_cast<float>(model_.shading.gain));
   const v_float32x4 inv_knee = cv::v_setall_f32(1.0f / kKneeGreyLevels);
   v_float32x4 colour[3][3];  // [led][channel]
   for (int i = 0; i < 3; ++i) {
@@ -298,53 +241,33 @@ cv::Mat3f DigitShader::shadingDifference(const cv::Mat1f& h_final_mm) const {
 cv::Mat3b DigitShader::shade(const cv::Mat1f& h_final_mm, std::int64_t noise_seed) const {
   checkHeight(h_final_mm);
   const cv::Rect box = contactBox(h_final_mm);
+  // Reused per thread: fresh pages cost ~13 us each on these VMs, a big press's box ~0.5 MB.
+  thread_local cv::Mat3f diff_scratch;
   cv::Mat3f diff;
   if (!box.empty()) {
-    diff.create(box.size());
+    if (diff_scratch.rows < box.height || diff_scratch.cols < box.width) {
+      diff_scratch.create(std::max(box.height, diff_scratch.rows),
+                          std::max(box.width, diff_scratch.cols));
+    }
+    diff = diff_scratch(cv::Rect(0, 0, box.width, box.height));
     shadeBox(h_final_mm, box, diff);
   }
-  const int rows = model_.rows, cols = model_.cols;
-  cv::Mat3b image(rows, cols);
-  const bool noisy = noise_seed >= 0 && !noise_table_.empty();
-
-  if (!noisy) {
-    background_.copyTo(image);
-    for (int r = box.y; r < box.y + box.height; ++r) {
-      const uchar* bg = background_.ptr<uchar>(r) + 3 * box.x;
-      uchar* out = image.ptr<uchar>(r) + 3 * box.x;
-      const float* d = diff.ptr<float>(r - box.y);
-      for (int k = 0; k < 3 * box.width; ++k) out[k] = cv::saturate_cast<uchar>(bg[k] + d[k]);
+  cv::Mat3b image;
+  background_.copyTo(image);
+  if (noise_seed < 0 || !addsNoise()) {
+    // background + diff, rounded and saturated (OpenCV's vectorised mixed-type add).
+    if (!box.empty()) {
+      cv::Mat out = image(box);
+      cv::add(background_(box), diff, out, cv::noArray(), CV_8U);
     }
     return image;
   }
-
-  // The noise stream runs over the whole frame in raster order, independent of the box, so a
-  // pixel's noise depends only on the seed and its position.
-  Xoshiro256 generator(static_cast<std::uint64_t>(noise_seed));
-  const float* table = noise_table_.data();
-  const int row_samples = 3 * cols;
-  std::vector<float> noise(row_samples + kSamplesPerDraw);
-  for (int r = 0; r < rows; ++r) {
-    for (int k = 0; k < row_samples; k += kSamplesPerDraw) {
-      std::uint64_t bits = generator.next();
-      for (int j = 0; j < kSamplesPerDraw; ++j, bits >>= kNoiseTableBits) {
-        noise[k + j] = table[bits & (kNoiseTableSize - 1)];
-      }
-    }
-    const uchar* bg = background_.ptr<uchar>(r);
-    uchar* out = image.ptr<uchar>(r);
-    const bool in_box = r >= box.y && r < box.y + box.height;
-    const int begin = in_box ? 3 * box.x : row_samples;
-    const int end = in_box ? 3 * (box.x + box.width) : row_samples;
-    for (int k = 0; k < begin; ++k) out[k] = cv::saturate_cast<uchar>(bg[k] + noise[k]);
-    if (in_box) {
-      const float* d = diff.ptr<float>(r - box.y);
-      for (int k = begin; k < end; ++k) {
-        out[k] = cv::saturate_cast<uchar>(bg[k] + d[k - begin] + noise[k]);
-      }
-    }
-    for (int k = end; k < row_samples; ++k) out[k] = cv::saturate_cast<uchar>(bg[k] + noise[k]);
-  }
+  // The noise covers the whole frame, independent of the box: a pixel's noise depends only on
+  // the seed and its position.
+  thread_local cv::Mat3f noise;  // reused per thread, like diff_scratch
+  noise_.generate(image.size(), static_cast<std::uint64_t>(noise_seed), noise);
+  if (!box.empty()) noise(box) += diff;
+  cv::add(background_, noise, image, cv::noArray(), CV_8U);
   return image;
 }
 

@@ -2,22 +2,73 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <set>
+#include <sstream>
 
 #include <yaml-cpp/yaml.h>
+#include <opencv2/core.hpp>
 
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader_response.hpp"
 
 namespace norm2tex {
 namespace {
 
-// TACTO's DIGIT lights sit 20 mm off the axis at 30, 150 and 270 degrees; seen through the
-// portrait image, red lights the top-left, green the top-right, blue the bottom. They sit
-// behind the gel surface (z < 0), on the camera's side of the membrane.
+// Real DIGIT presses brighten blue below the contact, green on its left (slightly up) and red
+// at its upper right, on every unit measured. The analytic model lights the side of a press
+// facing an LED, so red sits at 30 degrees above the right, green at 30 degrees above the left
+// and blue below (TACTO's 20 mm ring, with red and green swapped to match real units).
 std::array<LedModel, 3> defaultLeds() {
-  return {LedModel{"red", {-17.32, -10.0, -3.0}, {0.0, 0.0, 1.0}, 1.0},
-          LedModel{"green", {17.32, -10.0, -3.0}, {0.0, 1.0, 0.0}, 1.0},
+  return {LedModel{"red", {17.32, -10.0, -3.0}, {0.0, 0.0, 1.0}, 1.0},
+          LedModel{"green", {-17.32, -10.0, -3.0}, {0.0, 1.0, 0.0}, 1.0},
           LedModel{"blue", {0.0, 20.0, -3.0}, {1.0, 0.0, 0.0}, 1.0}};
+}
+
+const char* const kChannelNames[3] = {"blue", "green", "red"};
+
+// Every key a sensor yaml may hold, by section ("" = top level): anything else is a typo.
+const std::set<std::string>& allowedKeys(const std::string& section) {
+  static const std::map<std::string, std::set<std::string>> keys = {
+      {"",
+       {"preset", "image", "gel", "camera", "leds", "shading", "noise", "background_image",
+        "gel_model"}},
+      {"image", {"rows", "cols", "mm_per_pixel"}},
+      {"gel", {"thickness_mm", "curvature_radius_mm", "pad_width_mm", "pad_height_mm"}},
+      {"camera", {"fx", "fy", "cx", "cy"}},
+      {"leds[]", {"name", "position_mm", "color_bgr", "intensity"}},
+      {"shading", {"model", "gain", "shadow_sigma_mm", "response"}},
+      {"shading.response", {"blue", "green", "red"}},
+      {"noise",
+       {"sigma_bgr", "neighbour_correlation", "correlation_bg", "correlation_gr", "correlation_br",
+        "on_real_background"}},
+      {"gel_model", {"pyramid_sigmas_mm", "core_fraction", "final_sigma_mm"}},
+  };
+  return keys.at(section);
+}
+
+std::string joined(const std::set<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text;
+}
+
+// Throws Error naming the first key of `node` (a map) not allowed in `section`.
+void rejectUnknownKeys(const YAML::Node& node, const std::string& section) {
+  if (!node) return;
+  const std::string where = section.empty() ? "" : section + ".";
+  if (!node.IsMap()) throw Error((section.empty() ? "the file" : section) + " must be a map");
+  const std::set<std::string>& allowed = allowedKeys(section);
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    if (allowed.count(key) == 0) {
+      throw Error("unknown key '" + where + key + "'; valid keys" +
+                  (section.empty() ? "" : " in " + section) + ": " + joined(allowed));
+    }
+  }
 }
 
 template <typename T>
@@ -32,7 +83,51 @@ cv::Vec3d readVec3(const YAML::Node& node, const std::string& key) {
   return {values[0], values[1], values[2]};
 }
 
+ShadingKind parseShadingKind(const std::string& name) {
+  if (name == "calibrated") return ShadingKind::kCalibrated;
+  if (name == "analytic_leds") return ShadingKind::kAnalyticLeds;
+  throw Error("shading.model = '" + name + "' is not valid; valid: calibrated, analytic_leds");
+}
+
+void readShading(const YAML::Node& node, ShadingOptions& shading) {
+  if (!node) return;
+  rejectUnknownKeys(node, "shading");
+  std::string kind = shadingKindName(shading.kind);
+  read(node, "model", kind);
+  shading.kind = parseShadingKind(kind);
+  read(node, "gain", shading.gain);
+  read(node, "shadow_sigma_mm", shading.shadow_sigma_mm);
+  if (const YAML::Node response = node["response"]) {
+    rejectUnknownKeys(response, "shading.response");
+    for (int k = 0; k < 3; ++k) {
+      if (!response[kChannelNames[k]]) continue;
+      const std::vector<double> values = response[kChannelNames[k]].as<std::vector<double>>();
+      if (values.size() != static_cast<size_t>(kShadingFeatureCount)) {
+        throw Error(std::string("shading.response.") + kChannelNames[k] + " needs " +
+                    std::to_string(kShadingFeatureCount) + " numbers (" + shadingFeatureNames() +
+                    "), got " + std::to_string(values.size()));
+      }
+      std::copy(values.begin(), values.end(), shading.response_bgr[k].begin());
+    }
+  }
+}
+
+void readNoise(const YAML::Node& node, NoiseOptions& noise) {
+  if (!node) return;
+  rejectUnknownKeys(node, "noise");
+  if (node["sigma_bgr"]) noise.sigma_bgr = readVec3(node["sigma_bgr"], "noise.sigma_bgr");
+  read(node, "neighbour_correlation", noise.neighbour_correlation);
+  read(node, "correlation_bg", noise.correlation_bg);
+  read(node, "correlation_gr", noise.correlation_gr);
+  read(node, "correlation_br", noise.correlation_br);
+  read(node, "on_real_background", noise.on_real_background);
+}
+
 }  // namespace
+
+const char* shadingKindName(ShadingKind kind) {
+  return kind == ShadingKind::kCalibrated ? "calibrated" : "analytic_leds";
+}
 
 cv::Point2d SensorModel::pixelToGelMm(double row, double col) const {
   return {(col + 0.5 - cols / 2.0) * mm_per_pixel, (row + 0.5 - rows / 2.0) * mm_per_pixel};
@@ -41,10 +136,11 @@ cv::Point2d SensorModel::pixelToGelMm(double row, double col) const {
 SensorModel makeDigitSensorModel(bool vga) {
   SensorModel model;
   model.leds = defaultLeds();
+  model.shading.response_bgr = defaultShadingResponse();
   if (vga) {
     model.rows = 640;
     model.cols = 480;
-    model.mm_per_pixel = 0.04;
+    model.mm_per_pixel = 0.5 * model.mm_per_pixel;
     model.fx = model.fy = 554.3;
     model.cx = 239.5;
     model.cy = 319.5;
@@ -62,6 +158,10 @@ void validate(const SensorModel& m) {
                    m.gel_thickness_mm, "(0, 20] mm");
   requireParameter(m.gel_curvature_radius_mm == 0.0 || m.gel_curvature_radius_mm > 5.0,
                    "gel.curvature_radius_mm", m.gel_curvature_radius_mm, "0 (flat) or > 5 mm");
+  requireParameter(m.gel_pad_width_mm > 0.0 && m.gel_pad_width_mm <= 100.0, "gel.pad_width_mm",
+                   m.gel_pad_width_mm, "(0, 100] mm");
+  requireParameter(m.gel_pad_height_mm > 0.0 && m.gel_pad_height_mm <= 100.0,
+                   "gel.pad_height_mm", m.gel_pad_height_mm, "(0, 100] mm");
   requireParameter(m.fx > 0.0 && m.fy > 0.0, "camera.fx/fy", m.fx, "> 0 pixels");
   requireParameter(std::isfinite(m.cx) && std::isfinite(m.cy), "camera.cx/cy", m.cx, "finite");
   for (const LedModel& led : m.leds) {
@@ -74,10 +174,38 @@ void validate(const SensorModel& m) {
                        "leds." + led.name + ".color_bgr", led.color_bgr[i], "[0, 1] per channel");
     }
   }
-  requireParameter(m.shading_gain >= 0.0 && m.shading_gain <= 100.0, "shading_gain", m.shading_gain,
-                   "[0, 100]");
-  requireParameter(m.noise_sigma >= 0.0 && m.noise_sigma <= 64.0, "noise_sigma", m.noise_sigma,
-                   "[0, 64] grey levels");
+  const ShadingOptions& s = m.shading;
+  requireParameter(s.gain >= 0.0 && s.gain <= 100.0, "shading.gain", s.gain, "[0, 100]");
+  requireParameter(s.shadow_sigma_mm >= 0.05 && s.shadow_sigma_mm <= 3.0, "shading.shadow_sigma_mm",
+                   s.shadow_sigma_mm, "[0.05, 3] mm");
+  for (int k = 0; k < 3; ++k) {
+    for (const double value : s.response_bgr[k]) {
+      requireParameter(std::isfinite(value) && std::abs(value) <= 1e5,
+                       std::string("shading.response.") + kChannelNames[k], value,
+                       "finite numbers within +-1e5 grey levels");
+    }
+  }
+  const NoiseOptions& n = m.noise;
+  for (int k = 0; k < 3; ++k) {
+    requireParameter(n.sigma_bgr[k] >= 0.0 && n.sigma_bgr[k] <= 64.0, "noise.sigma_bgr",
+                     n.sigma_bgr[k], "[0, 64] grey levels per channel");
+  }
+  requireParameter(n.neighbour_correlation >= 0.0 && n.neighbour_correlation <= 0.7,
+                   "noise.neighbour_correlation", n.neighbour_correlation,
+                   "[0, 0.7] (a 3 x 3 kernel reaches at most 0.707)");
+  const double correlations[3] = {n.correlation_bg, n.correlation_gr, n.correlation_br};
+  const char* const correlation_names[3] = {"noise.correlation_bg", "noise.correlation_gr",
+                                            "noise.correlation_br"};
+  for (int i = 0; i < 3; ++i) {
+    requireParameter(std::abs(correlations[i]) < 1.0, correlation_names[i], correlations[i],
+                     "(-1, 1)");
+  }
+  // The three correlations must form a valid (positive definite) correlation matrix.
+  const double det = 1.0 + 2.0 * n.correlation_bg * n.correlation_gr * n.correlation_br -
+                     n.correlation_bg * n.correlation_bg - n.correlation_gr * n.correlation_gr -
+                     n.correlation_br * n.correlation_br;
+  requireParameter(det > 1e-6, "noise.correlation_bg/gr/br", det,
+                   "a positive definite correlation matrix (determinant > 0)");
   requireParameter(m.gel.core_fraction > 0.0 && m.gel.core_fraction <= 1.0,
                    "gel_model.core_fraction", m.gel.core_fraction, "(0, 1]");
   requireParameter(m.gel.final_sigma_mm >= 0.0 && m.gel.final_sigma_mm <= 5.0,
@@ -96,17 +224,24 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
     throw Error("sensor config '" + yaml_path + "': " + e.what());
   }
   try {
+    if (root.IsNull()) root = YAML::Node(YAML::NodeType::Map);  // an empty file: defaults
+    rejectUnknownKeys(root, "");
     std::string preset = "qvga";
     read(root, "preset", preset);
     if (preset != "qvga" && preset != "vga") {
       throw Error("preset = '" + preset + "' is not valid; valid: qvga, vga");
     }
     SensorModel m = makeDigitSensorModel(preset == "vga");
+    rejectUnknownKeys(root["image"], "image");
     read(root["image"], "rows", m.rows);
     read(root["image"], "cols", m.cols);
     read(root["image"], "mm_per_pixel", m.mm_per_pixel);
+    rejectUnknownKeys(root["gel"], "gel");
     read(root["gel"], "thickness_mm", m.gel_thickness_mm);
     read(root["gel"], "curvature_radius_mm", m.gel_curvature_radius_mm);
+    read(root["gel"], "pad_width_mm", m.gel_pad_width_mm);
+    read(root["gel"], "pad_height_mm", m.gel_pad_height_mm);
+    rejectUnknownKeys(root["camera"], "camera");
     read(root["camera"], "fx", m.fx);
     read(root["camera"], "fy", m.fy);
     read(root["camera"], "cx", m.cx);
@@ -114,6 +249,7 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
     if (const YAML::Node leds = root["leds"]) {
       if (!leds.IsSequence() || leds.size() != 3) throw Error("leds must list exactly 3 LEDs");
       for (size_t i = 0; i < 3; ++i) {
+        rejectUnknownKeys(leds[i], "leds[]");
         LedModel& led = m.leds[i];
         read(leds[i], "name", led.name);
         if (leds[i]["position_mm"])
@@ -122,10 +258,11 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
         read(leds[i], "intensity", led.intensity);
       }
     }
-    read(root, "shading_gain", m.shading_gain);
-    read(root, "noise_sigma", m.noise_sigma);
+    readShading(root["shading"], m.shading);
+    readNoise(root["noise"], m.noise);
     read(root, "background_image", m.background_image);
     if (const YAML::Node gel = root["gel_model"]) {
+      rejectUnknownKeys(gel, "gel_model");
       read(gel, "pyramid_sigmas_mm", m.gel.pyramid_sigmas_mm);
       read(gel, "core_fraction", m.gel.core_fraction);
       read(gel, "final_sigma_mm", m.gel.final_sigma_mm);
@@ -141,6 +278,65 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
   } catch (const Error& e) {
     throw Error("sensor config '" + yaml_path + "': " + e.what());
   }
+}
+
+namespace {
+
+std::string vec3(const cv::Vec3d& v) {
+  std::ostringstream out;
+  out << std::setprecision(9) << "[" << v[0] << ", " << v[1] << ", " << v[2] << "]";
+  return out.str();
+}
+
+}  // namespace
+
+void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
+  validate(m);
+  std::ostringstream out;
+  out << std::setprecision(9);
+  out << "# DIGIT sensor model for norm2tex (see config/digit.yaml for what each key means).\n"
+      << "# Lengths in mm, images in pixels, grey levels of 255; colours in OpenCV BGR order.\n"
+      << "image:\n  rows: " << m.rows << "\n  cols: " << m.cols
+      << "\n  mm_per_pixel: " << m.mm_per_pixel << "\n"
+      << "gel:\n  thickness_mm: " << m.gel_thickness_mm
+      << "\n  curvature_radius_mm: " << m.gel_curvature_radius_mm
+      << "\n  pad_width_mm: " << m.gel_pad_width_mm << "\n  pad_height_mm: " << m.gel_pad_height_mm
+      << "\n"
+      << "camera:\n  fx: " << m.fx << "\n  fy: " << m.fy << "\n  cx: " << m.cx << "\n  cy: " << m.cy
+      << "\n"
+      << "leds:\n";
+  for (const LedModel& led : m.leds) {
+    out << "  - name: " << led.name << "\n    position_mm: " << vec3(led.position_mm)
+        << "\n    color_bgr: " << vec3(led.color_bgr) << "\n    intensity: " << led.intensity
+        << "\n";
+  }
+  out << "shading:\n  model: " << shadingKindName(m.shading.kind) << "\n  gain: " << m.shading.gain
+      << "\n  shadow_sigma_mm: " << m.shading.shadow_sigma_mm
+      << "\n  response:   # grey levels per unit of: " << shadingFeatureNames() << "\n";
+  for (int k = 0; k < 3; ++k) {
+    out << "    " << kChannelNames[k] << ": [";
+    for (int j = 0; j < kShadingFeatureCount; ++j) {
+      out << (j ? ", " : "") << m.shading.response_bgr[k][j];
+    }
+    out << "]\n";
+  }
+  out << "noise:\n  sigma_bgr: " << vec3(m.noise.sigma_bgr)
+      << "\n  neighbour_correlation: " << m.noise.neighbour_correlation
+      << "\n  correlation_bg: " << m.noise.correlation_bg
+      << "\n  correlation_gr: " << m.noise.correlation_gr
+      << "\n  correlation_br: " << m.noise.correlation_br
+      << "\n  on_real_background: " << (m.noise.on_real_background ? "true" : "false") << "\n"
+      << "background_image: \"" << m.background_image << "\"\n"
+      << "gel_model:\n  pyramid_sigmas_mm: [";
+  for (size_t i = 0; i < m.gel.pyramid_sigmas_mm.size(); ++i) {
+    out << (i ? ", " : "") << m.gel.pyramid_sigmas_mm[i];
+  }
+  out << "]\n  core_fraction: " << m.gel.core_fraction
+      << "\n  final_sigma_mm: " << m.gel.final_sigma_mm << "\n";
+  std::ofstream file(yaml_path);
+  file << out.str();
+  file.close();
+  if (!file) throw Error("sensor config '" + yaml_path + "': cannot be written");
 }
 
 }  // namespace norm2tex

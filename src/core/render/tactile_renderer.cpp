@@ -20,10 +20,16 @@ cv::Mat1f TactileFrame::depthMetres() const {
 }
 
 TactileRenderer::TactileRenderer(const SensorModel& model)
-    : TactileRenderer(model, backgroundFor(model)) {}
+    : TactileRenderer(model, backgroundFor(model),
+                      model.background_image.empty() ? BackgroundSource::kSynthetic
+                                                     : BackgroundSource::kCaptured) {}
 
-TactileRenderer::TactileRenderer(const SensorModel& model, cv::Mat3b background)
-    : model_(model), rasterizer_(model), gel_(model), shader_(model, std::move(background)) {}
+TactileRenderer::TactileRenderer(const SensorModel& model, cv::Mat3b background,
+                                 BackgroundSource source)
+    : model_(model),
+      rasterizer_(model),
+      gel_(model),
+      shader_(model, std::move(background), source) {}
 
 std::string TactileRenderer::setObject(std::shared_ptr<const TexturedMesh> mesh,
                                        std::shared_ptr<const HeightAtlas> atlas, double beta_mm) {

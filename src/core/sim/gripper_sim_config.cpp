@@ -44,8 +44,8 @@ bool isPrimitive(const std::string& mesh) {
 }  // namespace
 
 void setGelFromSensor(const SensorModel& sensor, GripperSimConfig& config) {
-  config.gel_width_m = sensor.gelWidthMm() * 1e-3;
-  config.gel_height_m = sensor.gelHeightMm() * 1e-3;
+  config.gel_width_m = sensor.gel_pad_width_mm * 1e-3;
+  config.gel_height_m = sensor.gel_pad_height_mm * 1e-3;
   config.gel_thickness_m = sensor.gel_thickness_mm * 1e-3;
 }
 

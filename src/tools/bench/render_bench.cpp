@@ -109,7 +109,8 @@ void BM_Stage_Gel(benchmark::State& state) {
 }
 void BM_Stage_Shading(benchmark::State& state) {
   StageFixture f;
-  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()));
+  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()),
+                               norm2tex::BackgroundSource::kSynthetic);
   const bool noise = state.range(0) != 0;
   std::int64_t seed = 0;
   for (auto _ : state) {

@@ -1,0 +1,21 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "norm2tex/calibrate/sensor_calibration.hpp"
+
+namespace norm2tex {
+
+/// A side-by-side picture of a calibration: for up to `max_presses` held-out presses, one row
+/// of three crops around the press (2 x 1.6 contact radii, each scaled to 160 x 160):
+/// the real frame | the calibrated render (background + simulated difference) | real minus
+/// render, amplified 2x around grey 128. Above them, the held-out fit figures as text.
+cv::Mat3b makeCalibrationReport(const CalibrationResult& result, int max_presses = 4);
+
+/// The held-out fit figures as lines of text (for the report image and the tool's output).
+std::vector<std::string> describeFitQuality(const CalibrationResult& result);
+
+}  // namespace norm2tex

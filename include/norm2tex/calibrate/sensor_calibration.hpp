@@ -1,0 +1,66 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "norm2tex/calibrate/fit_quality.hpp"
+#include "norm2tex/calibrate/press_detection.hpp"
+#include "norm2tex/calibrate/shading_fit.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+
+namespace norm2tex {
+
+/// A frame and the name it is reported under (usually its file).
+struct NamedFrame {
+  std::string name;
+  cv::Mat3b image;  ///< BGR, portrait as the driver publishes it
+};
+
+/// What a user has of their DIGIT: no-contact frames and ball presses.
+struct CalibrationInput {
+  std::vector<NamedFrame> backgrounds;  ///< one or more no-contact frames (averaged)
+  std::vector<NamedFrame> presses;      ///< one ball press each, anywhere on the gel
+  /// Optional contact circles, one per press (nullopt: detect it); empty = detect all.
+  std::vector<std::optional<PressCircle>> labels;
+  double ball_diameter_mm = 0.0;
+  std::optional<double> mm_per_pixel;  ///< fitted when not given
+};
+
+struct CalibrationOptions {
+  /// Share of the presses held out of the fit and used to judge it (every n-th press).
+  double holdout_fraction = 0.3;
+};
+
+/// The fitted sensor and how well it reproduces presses it was not fitted on.
+struct CalibrationResult {
+  SensorModel model;     ///< base + fitted scale, shading and noise; background_image unset
+  cv::Mat3b background;  ///< mean of the no-contact frames
+  ShadingFit fit;        ///< on the training presses
+  FitQuality held_out;   ///< simulated vs real on the held-out presses
+  std::vector<PressObservation> held_out_presses;
+  std::vector<cv::Mat3f> held_out_simulated;  ///< the model's shading difference per press
+  std::vector<double> held_out_radii_px;      ///< fitted contact radii
+  int training_presses = 0;
+};
+
+/// Minimum number of presses: 3 to fit, 1 to hold out.
+constexpr int kMinCalibrationPresses = 4;
+
+/// Calibrates a DIGIT: averages the backgrounds, finds each press's contact circle
+/// (detectPress, unless labelled), removes the frame's lighting drift (per channel, the median
+/// difference farther than 2.2 contact radii from the press), holds out every n-th press, fits
+/// geometry and shading on the rest (fitShadingAndGeometry), refines every unlabelled press's
+/// circle against that model (refinePressCircle: geometry only, so held-out presses stay
+/// unseen by the shading fit), refits, renders the held-out presses with DigitShader at the
+/// fitted geometry and compares (compareWithReal), and measures the background noise
+/// (measureBackgroundNoise). `base` gives the image size and the parts not
+/// fitted (gel smoothing, camera, LEDs). Throws Error naming the frame for frames of another
+/// size or orientation than `base`, presses it cannot find, a ball that cannot make the
+/// contacts, or fewer than kMinCalibrationPresses presses.
+CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
+                                  const CalibrationOptions& options = {});
+
+}  // namespace norm2tex

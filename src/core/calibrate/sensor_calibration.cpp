@@ -1,0 +1,171 @@
+#include "norm2tex/calibrate/sensor_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "norm2tex/calibrate/background_noise.hpp"
+#include "norm2tex/calibrate/press_refinement.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader.hpp"
+
+namespace norm2tex {
+namespace {
+
+constexpr double kDriftRegionRadii = 2.2;
+
+std::string sizeText(const cv::Mat& image) {
+  return std::to_string(image.cols) + " x " + std::to_string(image.rows) +
+         (image.cols > image.rows ? " (landscape)" : " (portrait)");
+}
+
+void checkFrame(const SensorModel& base, const NamedFrame& frame, const char* role) {
+  if (frame.image.empty()) throw Error(std::string(role) + " '" + frame.name + "' is empty");
+  if (frame.image.size() == base.imageSize()) return;
+  const bool portrait = base.rows > base.cols;
+  if ((frame.image.rows > frame.image.cols) != portrait && frame.image.rows != frame.image.cols) {
+    throw Error(std::string(role) + " '" + frame.name + "' is " + sizeText(frame.image) +
+                " but the sensor's frames are " + std::to_string(base.cols) + " x " +
+                std::to_string(base.rows) + (portrait ? " (portrait)" : " (landscape)") +
+                "; rotate it the way your driver publishes frames");
+  }
+  throw Error(std::string(role) + " '" + frame.name + "' is " + sizeText(frame.image) +
+              " but the sensor's frames (and the first background) are " +
+              std::to_string(base.cols) + " x " + std::to_string(base.rows));
+}
+
+cv::Mat3f meanBackground(const std::vector<NamedFrame>& backgrounds) {
+  cv::Mat3f sum(backgrounds[0].image.size(), cv::Vec3f(0, 0, 0));
+  for (const NamedFrame& frame : backgrounds) {
+    cv::Mat3f f;
+    frame.image.convertTo(f, CV_32F);
+    sum += f;
+  }
+  return sum / static_cast<double>(backgrounds.size());
+}
+
+// Removes a global per-channel offset (lighting drift between the background and the press):
+// the median difference of the pixels far from the press.
+void removeDrift(PressObservation& press) {
+  const double far = kDriftRegionRadii * press.circle.radius_px;
+  std::vector<float> values[3];
+  for (int r = 0; r < press.diff.rows; ++r) {
+    for (int c = 0; c < press.diff.cols; ++c) {
+      const double dx = c - press.circle.centre_px.x, dy = r - press.circle.centre_px.y;
+      if (dx * dx + dy * dy < far * far) continue;
+      for (int k = 0; k < 3; ++k) values[k].push_back(press.diff(r, c)[k]);
+    }
+  }
+  if (values[0].size() < 100) return;  // the press fills the frame: nothing to compare with
+  cv::Vec3f offset;
+  for (int k = 0; k < 3; ++k) {
+    std::nth_element(values[k].begin(), values[k].begin() + values[k].size() / 2, values[k].end());
+    offset[k] = values[k][values[k].size() / 2];
+  }
+  press.diff -= cv::Scalar(offset[0], offset[1], offset[2]);
+}
+
+}  // namespace
+
+CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
+                                  const CalibrationOptions& options) {
+  validate(base);
+  if (input.backgrounds.empty()) throw Error("calibration needs at least one background frame");
+  if (static_cast<int>(input.presses.size()) < kMinCalibrationPresses) {
+    throw Error("calibration needs at least " + std::to_string(kMinCalibrationPresses) +
+                " ball presses (3 to fit, 1 to hold out); got " +
+                std::to_string(input.presses.size()));
+  }
+  if (!(input.ball_diameter_mm > 0.0 && input.ball_diameter_mm <= 100.0)) {
+    std::ostringstream message;
+    message << "ball diameter = " << input.ball_diameter_mm
+            << " mm is out of range; valid: (0, 100]";
+    throw Error(message.str());
+  }
+  if (!input.labels.empty() && input.labels.size() != input.presses.size()) {
+    throw Error("labels: " + std::to_string(input.labels.size()) + " given for " +
+                std::to_string(input.presses.size()) + " presses; give one per press or none");
+  }
+  if (!(options.holdout_fraction > 0.0 && options.holdout_fraction < 1.0)) {
+    throw Error("holdout fraction must be in (0, 1)");
+  }
+  for (const NamedFrame& frame : input.backgrounds) checkFrame(base, frame, "background");
+  for (const NamedFrame& frame : input.presses) checkFrame(base, frame, "press");
+
+  CalibrationResult result;
+  const cv::Mat3f background = meanBackground(input.backgrounds);
+  background.convertTo(result.background, CV_8U);
+
+  // Contact circles and drift-corrected differences.
+  std::vector<PressObservation> training, held_out;
+  std::set<std::string> labelled;  // presses whose circle the user gave: never refined
+  const int n = static_cast<int>(input.presses.size());
+  const int held_out_count =
+      std::clamp(static_cast<int>(std::lround(options.holdout_fraction * n)), 1, n - 3);
+  for (int i = 0; i < n; ++i) {
+    PressObservation press;
+    press.name = input.presses[i].name;
+    input.presses[i].image.convertTo(press.diff, CV_32F);
+    press.diff -= background;
+    const bool has_label = !input.labels.empty() && input.labels[i];
+    press.circle = has_label ? *input.labels[i] : detectPress(press.diff, press.name);
+    if (has_label) labelled.insert(press.name);
+    removeDrift(press);
+    // Spread the held-out presses evenly over the set: press i is held out when the running
+    // count floor((i + 1) k / n) steps up.
+    const bool hold = (i + 1) * held_out_count / n > i * held_out_count / n;
+    (hold ? held_out : training).push_back(std::move(press));
+  }
+
+  const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
+  // A first fit on the detected circles, then every press's circle refined against it (labelled
+  // ones are kept), then the final fit.
+  const ShadingFit first =
+      fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
+  {
+    SensorModel model = base;
+    model.mm_per_pixel = first.geometry.mm_per_pixel;
+    model.shading = first.shading;
+    const DigitShader shader(model, cv::Mat3b(base.imageSize(), cv::Vec3b(0, 0, 0)),
+                             BackgroundSource::kCaptured);
+    for (std::vector<PressObservation>* set : {&training, &held_out}) {
+      for (PressObservation& press : *set) {
+        if (labelled.count(press.name)) continue;
+        PressCircle start = press.circle;
+        start.radius_px *= first.geometry.radius_factor;
+        press.circle = refinePressCircle(shader, model, press, start, ball_radius_mm);
+      }
+    }
+  }
+  // The refined circles carry the first radius factor: the refit starts from factor 1.
+  result.fit = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel,
+                                     PressGeometry{first.geometry.mm_per_pixel, 1.0});
+  result.training_presses = static_cast<int>(training.size());
+
+  result.model = base;
+  result.model.mm_per_pixel = result.fit.geometry.mm_per_pixel;
+  result.model.gel = result.fit.gel;
+  result.model.shading = result.fit.shading;
+  result.model.noise = measureBackgroundNoise([&] {
+    std::vector<cv::Mat3b> frames;
+    for (const NamedFrame& frame : input.backgrounds) frames.push_back(frame.image);
+    return frames;
+  }());
+  result.model.background_image.clear();
+
+  // Held-out presses, rendered by the shader itself at the fitted geometry.
+  const DigitShader shader(result.model, result.background, BackgroundSource::kCaptured);
+  for (PressObservation& press : held_out) {
+    const cv::Mat1f gel =
+        simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm);
+    result.held_out_simulated.push_back(shader.shadingDifference(gel));
+    result.held_out_radii_px.push_back(press.circle.radius_px * result.fit.geometry.radius_factor);
+  }
+  result.held_out_presses = std::move(held_out);
+  result.held_out =
+      compareWithReal(result.held_out_presses, result.held_out_simulated, result.held_out_radii_px);
+  return result;
+}
+
+}  // namespace norm2tex

@@ -1,0 +1,269 @@
+#include "norm2tex/calibrate/shading_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/calibrate/ball_press.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader_response.hpp"
+#include "norm2tex/render/gel_model.hpp"
+
+namespace norm2tex {
+namespace {
+
+constexpr int kF = kShadingFeatureCount;
+constexpr size_t kMaxSearchPresses = 16;
+
+// Normal equations of the per-channel least squares, pooled over presses.
+struct NormalEquations {
+  cv::Matx<double, kF, kF> a = cv::Matx<double, kF, kF>::zeros();
+  cv::Matx<double, kF, 3> b = cv::Matx<double, kF, 3>::zeros();
+  cv::Vec3d yy{0, 0, 0}, y_sum{0, 0, 0};
+  double count = 0.0;
+};
+
+void accumulate(const SensorModel& model, const PressObservation& press, const cv::Mat1f& gel,
+                NormalEquations& eq) {
+  const int reach = shadingReachPixels(model.mm_per_pixel, model.shading.shadow_sigma_mm);
+  cv::Rect box = cv::boundingRect(gel > 0.0f);
+  const cv::Rect image(0, 0, gel.cols, gel.rows);
+  ShadingFeatureArray features;
+  if (!box.empty()) {
+    box = cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
+          image;
+    computeShadingFeatures(gel, model.mm_per_pixel, model.shading.shadow_sigma_mm, box, features);
+  }
+  const double radius = kFitRegionRadii * press.circle.radius_px;
+  const cv::Point2d centre = press.circle.centre_px;
+  const cv::Rect region = cv::Rect(cvFloor(centre.x - radius), cvFloor(centre.y - radius),
+                                   cvCeil(2 * radius) + 2, cvCeil(2 * radius) + 2) &
+                          image;
+  // Rows of features and targets of the region's pixels, then A += F^T F and B += F^T Y by
+  // matrix products (much faster than per-pixel rank-one updates).
+  cv::Mat1f f_rows(region.area(), kF, 0.0f), y_rows(region.area(), 3);
+  int n = 0;
+  for (int r = region.y; r < region.y + region.height; ++r) {
+    const cv::Vec3f* y_row = press.diff.ptr<cv::Vec3f>(r);
+    for (int c = region.x; c < region.x + region.width; ++c) {
+      const double dx = c - centre.x, dy = r - centre.y;
+      if (dx * dx + dy * dy > radius * radius) continue;
+      const cv::Vec3f y = y_row[c];
+      for (int k = 0; k < 3; ++k) {
+        eq.yy[k] += y[k] * y[k];
+        eq.y_sum[k] += y[k];
+        y_rows(n, k) = y[k];
+      }
+      eq.count += 1.0;
+      if (box.contains(cv::Point(c, r))) {  // every feature is 0 outside the box
+        float* f = f_rows.ptr<float>(n);
+        for (int j = 0; j < kF; ++j) f[j] = features[j](r - box.y, c - box.x);
+      }
+      ++n;
+    }
+  }
+  if (n == 0) return;
+  const cv::Mat1f f_used = f_rows.rowRange(0, n), y_used = y_rows.rowRange(0, n);
+  cv::Mat1f ata, aty;
+  cv::gemm(f_used, f_used, 1.0, cv::noArray(), 0.0, ata, cv::GEMM_1_T);
+  cv::gemm(f_used, y_used, 1.0, cv::noArray(), 0.0, aty, cv::GEMM_1_T);
+  for (int i = 0; i < kF; ++i) {
+    for (int j = i; j < kF; ++j) eq.a(i, j) += ata(i, j);
+    for (int k = 0; k < 3; ++k) eq.b(i, k) += aty(i, k);
+  }
+}
+
+ShadingFit solve(const NormalEquations& eq, const PressGeometry& geometry, double shadow_sigma_mm) {
+  cv::Matx<double, kF, kF> a = eq.a;
+  double trace = 0.0;
+  for (int i = 0; i < kF; ++i) {
+    for (int j = 0; j < i; ++j) a(i, j) = a(j, i);
+    trace += a(i, i);
+  }
+  // A tiny ridge keeps features that never vary (a press set without depth change) harmless.
+  for (int i = 0; i < kF; ++i) a(i, i) += 1e-9 * trace / kF + 1e-12;
+  cv::Matx<double, kF, 3> coefficients;
+  cv::solve(a, eq.b, coefficients, cv::DECOMP_CHOLESKY);
+  ShadingFit fit;
+  fit.geometry = geometry;
+  fit.shading.kind = ShadingKind::kCalibrated;
+  fit.shading.gain = 1.0;
+  fit.shading.shadow_sigma_mm = shadow_sigma_mm;
+  double sse = 0.0, sst = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    double c_b = 0.0, c_a_c = 0.0;
+    for (int i = 0; i < kF; ++i) {
+      fit.shading.response_bgr[k][i] = coefficients(i, k);
+      c_b += coefficients(i, k) * eq.b(i, k);
+      for (int j = 0; j < kF; ++j) c_a_c += coefficients(i, k) * a(i, j) * coefficients(j, k);
+    }
+    sse += eq.yy[k] - 2.0 * c_b + c_a_c;
+    sst += eq.yy[k] - eq.y_sum[k] * eq.y_sum[k] / std::max(eq.count, 1.0);
+  }
+  fit.variance_explained = sst > 0.0 ? 1.0 - sse / sst : 0.0;
+  return fit;
+}
+
+}  // namespace
+
+cv::Mat1f simulatedPressGel(const SensorModel& base, const PressCircle& circle,
+                            const PressGeometry& geometry, double ball_radius_mm) {
+  SensorModel model = base;
+  model.mm_per_pixel = geometry.mm_per_pixel;
+  PressCircle contact = circle;
+  contact.radius_px *= geometry.radius_factor;
+  const cv::Mat1f indentation = ballPressIndentation(model, contact, ball_radius_mm);
+  cv::Mat1f gel;
+  GelModel(model).apply(indentation, gel);
+  return gel;
+}
+
+ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressObservation>& presses,
+                              const PressGeometry& geometry, double ball_radius_mm,
+                              double shadow_sigma_mm) {
+  if (presses.empty()) throw Error("fitShadingResponse: no presses");
+  SensorModel model = base;
+  model.mm_per_pixel = geometry.mm_per_pixel;
+  model.shading.shadow_sigma_mm = shadow_sigma_mm;
+  NormalEquations eq;
+  for (const PressObservation& press : presses) {
+    const cv::Mat1f gel = simulatedPressGel(base, press.circle, geometry, ball_radius_mm);
+    accumulate(model, press, gel, eq);
+  }
+  ShadingFit fit = solve(eq, geometry, shadow_sigma_mm);
+  fit.gel = base.gel;
+  return fit;
+}
+
+ShadingFit fitShadingAndGeometry(const SensorModel& base,
+                                 const std::vector<PressObservation>& presses,
+                                 double ball_radius_mm, std::optional<double> mm_per_pixel,
+                                 std::optional<PressGeometry> start) {
+  if (presses.empty()) throw Error("fitShadingAndGeometry: no presses");
+  double largest_radius_px = 0.0;
+  for (const PressObservation& p : presses)
+    largest_radius_px = std::max(largest_radius_px, p.circle.radius_px);
+  const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
+  const double scale_lo = kMinSearchedScale * qvga, scale_hi = kMaxSearchedScale * qvga;
+  const double factor_lo = 0.6, factor_hi = 1.3;
+  // Largest scale at which every contact (radius x factor) still fits the ball.
+  const auto feasibleScale = [&](double factor) {
+    return 0.97 * ball_radius_mm / (factor * largest_radius_px);
+  };
+  if (mm_per_pixel && *mm_per_pixel > feasibleScale(factor_lo)) {
+    std::ostringstream message;
+    message << "the largest press (contact radius " << largest_radius_px
+            << " px = " << largest_radius_px * *mm_per_pixel << " mm at " << *mm_per_pixel
+            << " mm/px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
+            << " mm can make; check --ball-diameter-mm and --mm-per-pixel";
+    throw Error(message.str());
+  }
+  if (!mm_per_pixel && feasibleScale(factor_lo) < scale_lo) {
+    std::ostringstream message;
+    message << "the largest press (contact radius " << largest_radius_px
+            << " px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
+            << " mm can make at any plausible scale (>= " << scale_lo
+            << " mm/px); check --ball-diameter-mm";
+    throw Error(message.str());
+  }
+
+  const double default_sigma = makeDigitSensorModel().shading.shadow_sigma_mm;
+  ShadingFit best;
+  best.variance_explained = -1e300;
+  // Searching the scale renders every press for each candidate: with many presses, search on
+  // an evenly spread subset of kMaxSearchPresses, then fit the response on all of them.
+  std::vector<PressObservation> subset;
+  const bool use_subset = !mm_per_pixel && presses.size() > kMaxSearchPresses;
+  if (use_subset) {
+    for (size_t i = 0; i < kMaxSearchPresses; ++i) {
+      subset.push_back(presses[i * presses.size() / kMaxSearchPresses]);
+    }
+  }
+  const std::vector<PressObservation>& search = use_subset ? subset : presses;
+  SensorModel model = base;
+  const auto tryGeometry = [&](PressGeometry g, double sigma) {
+    g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
+    if (mm_per_pixel) g.mm_per_pixel = *mm_per_pixel;
+    g.mm_per_pixel =
+        std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
+    if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) return false;
+    const ShadingFit fit = fitShadingResponse(model, search, g, ball_radius_mm, sigma);
+    if (fit.variance_explained <= best.variance_explained) return false;
+    best = fit;
+    return true;
+  };
+
+  // Coarse grid: factor in steps of 0.1, scale log-spaced (12 steps over the range).
+  constexpr int kScaleSteps = 12;
+  const double scale_ratio = std::pow(scale_hi / scale_lo, 1.0 / (kScaleSteps - 1));
+  if (start) tryGeometry(*start, default_sigma);
+  for (double factor = factor_lo; !start && factor <= factor_hi + 1e-9; factor += 0.1) {
+    const double top = std::min(scale_hi, feasibleScale(factor));
+    for (int i = 0; i < (mm_per_pixel ? 1 : kScaleSteps); ++i) {
+      const double scale = scale_lo * std::pow(scale_ratio, i);
+      if (!mm_per_pixel && scale > top) break;
+      tryGeometry({scale, factor}, default_sigma);
+    }
+  }
+  // Local pattern search around the best, halving the steps when nothing improves.
+  double scale_step = start ? std::sqrt(scale_ratio) : scale_ratio;
+  double factor_step = start ? 0.025 : 0.05;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    const PressGeometry centre = best.geometry;
+    bool improved = false;
+    for (const double factor_move : {-1.0, 0.0, 1.0}) {
+      for (const double scale_move : {-1.0, 0.0, 1.0}) {
+        if (factor_move == 0.0 && scale_move == 0.0) continue;
+        if (mm_per_pixel && scale_move != 0.0) continue;
+        const PressGeometry g{centre.mm_per_pixel * std::pow(scale_step, scale_move),
+                              centre.radius_factor + factor_move * factor_step};
+        improved |= tryGeometry(g, default_sigma);
+      }
+    }
+    if (!improved) {
+      scale_step = std::sqrt(scale_step);
+      factor_step *= 0.5;
+    }
+  }
+  // The rim-shadow width at the chosen geometry, up to 0.6 mm: wider fits the calibration set
+  // barely better (held-out variance explained +0.01) but widens the shaded box, which costs
+  // render time. (The gel's own smoothing is not fitted: a wider final blur fits these presses
+  // no better, and it would wash out Norm2Tex texture.)
+  for (const double sigma : {0.2, 0.3, 0.45, 0.6}) tryGeometry(best.geometry, sigma);
+  // And the geometry once more with it.
+  factor_step = 0.02;
+  scale_step = std::sqrt(std::sqrt(scale_ratio));
+  for (int iteration = 0; iteration < 6; ++iteration) {
+    const PressGeometry centre = best.geometry;
+    bool improved = false;
+    for (const double factor_move : {-1.0, 0.0, 1.0}) {
+      for (const double scale_move : {-1.0, 0.0, 1.0}) {
+        if ((factor_move == 0.0 && scale_move == 0.0) || (mm_per_pixel && scale_move != 0.0)) {
+          continue;
+        }
+        improved |= tryGeometry({centre.mm_per_pixel * std::pow(scale_step, scale_move),
+                                 centre.radius_factor + factor_move * factor_step},
+                                best.shading.shadow_sigma_mm);
+      }
+    }
+    if (!improved) {
+      scale_step = std::sqrt(scale_step);
+      factor_step *= 0.5;
+    }
+  }
+  const double s = best.geometry.mm_per_pixel;
+  best.scale_at_search_bound =
+      !mm_per_pixel && (s <= scale_lo * 1.01 ||
+                        s >= 0.99 * std::min(scale_hi, feasibleScale(best.geometry.radius_factor)));
+  if (use_subset) {
+    const bool at_bound = best.scale_at_search_bound;
+    best = fitShadingResponse(model, presses, best.geometry, ball_radius_mm,
+                              best.shading.shadow_sigma_mm);
+    best.scale_at_search_bound = at_bound;
+  }
+  return best;
+}
+
+}  // namespace norm2tex

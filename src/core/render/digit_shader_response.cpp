@@ -1,0 +1,337 @@
+#include "norm2tex/render/digit_shader_response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/common/error.hpp"
+
+namespace norm2tex {
+namespace {
+
+const char* const kFeatureNames[kShadingFeatureCount] = {
+    "slope_x",    "slope_y",    "slope_xx",   "slope_xy",   "slope_yy",    "depth",
+    "rim_out",    "rim_in",     "rim_right",  "rim_left",   "rim_down",    "rim_up",
+    "slope_x*u",  "slope_x*v",  "slope_y*u",  "slope_y*v",  "rim_right*u", "rim_right*v",
+    "rim_left*u", "rim_left*v", "rim_down*u", "rim_down*v", "rim_up*u",    "rim_up*v"};
+
+// Gaussian blur of gel_mm over `region` with a wide sigma (pixels), replicating the image
+// border. Wide blurs run on a copy reduced by a whole factor (sigma / kSigmaPerReducedPixel,
+// area averaging) and are upsampled bilinearly: the blurred field is smooth, so this costs no
+// visible accuracy but cuts the cost of a 0.6 mm blur at QVGA about 20-fold. The reduced grid
+// is aligned to multiples of the factor in image coordinates, so a pixel's value does not
+// depend on the region it was computed in (the shader's box or a whole frame).
+constexpr double kSigmaPerReducedPixel = 2.5;
+
+int reductionFactor(double sigma_px) {
+  return std::max(1, static_cast<int>(sigma_px / kSigmaPerReducedPixel));
+}
+
+// How far the (reduced, truncated at 3 sigma, upsampled) blur spreads a value.
+int blurRadiusPixels(double mm_per_pixel, double shadow_sigma_mm) {
+  const double sigma_px = shadow_sigma_mm / mm_per_pixel;
+  return static_cast<int>(std::ceil(3.0 * sigma_px)) + 2 * reductionFactor(sigma_px);
+}
+
+// The per-frame path reuses these per thread (fresh pages cost ~13 us each on these VMs).
+struct BlurScratch {
+  cv::Mat1f snapped, small, full;
+};
+
+void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, cv::Mat1f& out) {
+  thread_local BlurScratch scratch;
+  const int factor = reductionFactor(sigma_px);
+  // The region snapped outwards to the reduced grid, padded by replication past the image.
+  const int x0 = region.x / factor * factor, y0 = region.y / factor * factor;
+  const int x1 = (region.x + region.width + factor - 1) / factor * factor;
+  const int y1 = (region.y + region.height + factor - 1) / factor * factor;
+  const cv::Rect inside =
+      cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  cv::Mat1f& snapped = scratch.snapped;
+  cv::copyMakeBorder(gel_mm(inside), snapped, 0, y1 - y0 - inside.height, 0, x1 - x0 - inside.width,
+                     cv::BORDER_REPLICATE);
+  cv::Mat1f& small = factor > 1 ? scratch.small : snapped;
+  if (factor > 1) {
+    cv::resize(snapped, small, cv::Size(snapped.cols / factor, snapped.rows / factor), 0, 0,
+               cv::INTER_AREA);
+  }
+  const double sigma_small = sigma_px / factor;
+  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_small)));
+  cv::GaussianBlur(small, small, cv::Size(2 * radius + 1, 2 * radius + 1), sigma_small, sigma_small,
+                   cv::BORDER_REPLICATE);
+  cv::Mat1f& full = factor > 1 ? scratch.full : small;
+  if (factor > 1) cv::resize(small, full, snapped.size(), 0, 0, cv::INTER_LINEAR);
+  full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).copyTo(out);
+}
+
+}  // namespace
+
+std::string shadingFeatureNames() {
+  std::string names;
+  for (const char* name : kFeatureNames) names += (names.empty() ? "" : ", ") + std::string(name);
+  return names;
+}
+
+std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse() {
+  // Fitted by norm2tex_calibrate on digit_calibration_s09 (see config/digit.yaml, which holds
+  // the same numbers, and README "Calibrate your own DIGIT").
+  // Rows B, G, R; columns in the order of shadingFeatureNames().
+  return {{{{// blue
+             -1.7029, -27.0042, -22.5671,  8.1038,   50.1430,  1.2310,   -14.0443, -29.4138,
+             -3.9875, 49.1282,  -195.7080, 136.3275, -10.2096, 39.5105,  -24.7101, -33.8021,
+             31.6150, -23.9993, -56.9498,  -28.5463, 74.1623,  -68.9803, -81.8773, 74.9964}},
+           {{// green
+             22.7729, -14.1977, 6.5536,   11.9932,  -11.0092, -1.8850,  4.3925,  -8.6974,
+             34.8648, -56.6451, 60.3049,  -34.5307, 31.0407,  -24.5424, 42.9954, -46.6421,
+             71.4478, -53.8582, -25.5489, -13.7633, -21.3278, 109.7863, 33.0463, -88.1230}},
+           {{// red
+             -40.9611,  28.8587,  10.4038,   -19.5692,  -25.0703, 17.6520,  -7.5369,  51.8362,
+             -126.7547, 102.7007, 114.6011,  -98.8973,  57.8865,  41.4779,  -60.4570, -36.5937,
+             134.7587,  109.4196, -140.2055, -132.1345, -36.4502, 113.7772, 22.2459,  -70.8375}}}};
+}
+
+int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm) {
+  // The blur spreads the deformation by its radius; the central differences of its slopes by
+  // one more pixel.
+  return blurRadiusPixels(mm_per_pixel, shadow_sigma_mm) + 2;
+}
+
+void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double shadow_sigma_mm,
+                            const cv::Rect& box, ShadingFeatureArray& features) {
+  if ((box & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows)) != box || box.empty()) {
+    throw Error("computeShadingFeatures: box outside the image");
+  }
+  for (cv::Mat1f& plane : features) plane.create(box.size());
+  const float inv_pixel = static_cast<float>(1.0 / mm_per_pixel);
+  const int last_row = gel_mm.rows - 1, last_col = gel_mm.cols - 1;
+  const float inv_half_cols = 2.0f / gel_mm.cols, inv_half_rows = 2.0f / gel_mm.rows;
+
+  // B = H blurred, over the box grown by one pixel for its differences (and by the kernel, so
+  // the blur inside sees the real neighbourhood); a copy, so the image border replicates.
+  const int radius = blurRadiusPixels(mm_per_pixel, shadow_sigma_mm);
+  cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
+                  box.height + 2 * radius + 2);
+  region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  cv::Mat1f blurred;
+  blurWide(gel_mm, region, shadow_sigma_mm / mm_per_pixel, blurred);
+
+  for (int j = 0; j < box.height; ++j) {
+    const int r = box.y + j;
+    const int r0 = std::max(r - 1, 0), r1 = std::min(r + 1, last_row);
+    const float dy_scale = inv_pixel / static_cast<float>(r1 - r0);
+    const float* up = gel_mm.ptr<float>(r0);
+    const float* mid = gel_mm.ptr<float>(r);
+    const float* down = gel_mm.ptr<float>(r1);
+    const float* b_up = blurred.ptr<float>(r0 - region.y);
+    const float* b_mid = blurred.ptr<float>(r - region.y);
+    const float* b_down = blurred.ptr<float>(r1 - region.y);
+    float* out[kShadingFeatureCount];
+    for (int f = 0; f < kShadingFeatureCount; ++f) out[f] = features[f].ptr<float>(j);
+    for (int i = 0; i < box.width; ++i) {
+      const int c = box.x + i;
+      const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, last_col);
+      const float dx_scale = inv_pixel / static_cast<float>(c1 - c0);
+      const float gx = (mid[c1] - mid[c0]) * dx_scale;
+      const float gy = (down[c] - up[c]) * dy_scale;
+      const int bc = c - region.x, bc0 = c0 - region.x, bc1 = c1 - region.x;
+      out[0][i] = gx;
+      out[1][i] = gy;
+      out[2][i] = gx * gx;
+      out[3][i] = gx * gy;
+      out[4][i] = gy * gy;
+      out[5][i] = mid[c];
+      const float rim = b_mid[bc] - mid[c];
+      out[6][i] = std::max(rim, 0.0f);
+      out[7][i] = std::min(rim, 0.0f);
+      const float bx = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
+      const float by = (b_down[bc] - b_up[bc]) * dy_scale;
+      out[8][i] = std::max(bx, 0.0f);
+      out[9][i] = std::max(-bx, 0.0f);
+      out[10][i] = std::max(by, 0.0f);
+      out[11][i] = std::max(-by, 0.0f);
+      const float u = (c + 0.5f) * inv_half_cols - 1.0f, v = (r + 0.5f) * inv_half_rows - 1.0f;
+      out[12][i] = gx * u;
+      out[13][i] = gx * v;
+      out[14][i] = gy * u;
+      out[15][i] = gy * v;
+      for (int q = 0; q < 4; ++q) {
+        out[16 + 2 * q][i] = out[8 + q][i] * u;
+        out[17 + 2 * q][i] = out[8 + q][i] * v;
+      }
+    }
+  }
+}
+
+void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
+                              const ShadingOptions& shading, const cv::Rect& box, cv::Mat3f& diff) {
+  if ((box & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows)) != box || box.empty()) {
+    throw Error("computeShadingDifference: box outside the image");
+  }
+  diff.create(box.size());
+  const float inv_pixel = static_cast<float>(1.0 / mm_per_pixel);
+  const int last_row = gel_mm.rows - 1, last_col = gel_mm.cols - 1;
+  const float inv_half_cols = 2.0f / gel_mm.cols, inv_half_rows = 2.0f / gel_mm.rows;
+  const double sigma_mm = shading.shadow_sigma_mm;
+  const int radius = blurRadiusPixels(mm_per_pixel, sigma_mm);
+  cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
+                  box.height + 2 * radius + 2);
+  region &= cv::Rect(0, 0, gel_mm.cols, gel_mm.rows);
+  thread_local cv::Mat1f blurred;
+  blurWide(gel_mm, region, sigma_mm / mm_per_pixel, blurred);
+
+  float w[3][kShadingFeatureCount];
+  for (int k = 0; k < 3; ++k) {
+    for (int f = 0; f < kShadingFeatureCount; ++f) {
+      w[k][f] = static_cast<float>(shading.gain * shading.response_bgr[k][f]);
+    }
+  }
+  // Base features whose coefficient varies with the position: slope_x, slope_y, rim_right,
+  // rim_left, rim_down, rim_up, with their u- and v-terms.
+  constexpr int kVarying = 6;
+  const int base[kVarying] = {0, 1, 8, 9, 10, 11};
+  const int u_term[kVarying] = {12, 14, 16, 18, 20, 22};
+
+  constexpr int kLanes = 4;
+  const int width = box.width;
+  const int padded = (width + kLanes - 1) / kLanes * kLanes;
+  // Row buffers, padded so that the last SIMD step may read past the box; reused per thread.
+  thread_local std::vector<float> rows_scratch;
+  rows_scratch.assign(9 * padded, 0.0f);
+  float* gx = rows_scratch.data();
+  float* gy = gx + padded;
+  float* hh = gy + padded;
+  float* rim = hh + padded;
+  float* bx = rim + padded;
+  float* by = bx + padded;
+  float* out = by + padded;
+  using cv::v_float32x4;
+  const v_float32x4 zero = cv::v_setzero_f32();
+  const v_float32x4 lane_u(0.0f, inv_half_cols, 2.0f * inv_half_cols, 3.0f * inv_half_cols);
+
+  for (int j = 0; j < box.height; ++j) {
+    const int r = box.y + j;
+    const int r0 = std::max(r - 1, 0), r1 = std::min(r + 1, last_row);
+    const float dy_scale = inv_pixel / static_cast<float>(r1 - r0);
+    const float* up = gel_mm.ptr<float>(r0);
+    const float* mid = gel_mm.ptr<float>(r);
+    const float* down = gel_mm.ptr<float>(r1);
+    const float* b_up = blurred.ptr<float>(r0 - region.y);
+    const float* b_mid = blurred.ptr<float>(r - region.y);
+    const float* b_down = blurred.ptr<float>(r1 - region.y);
+    // Interior columns without clamping (so the compiler vectorises them); the image's first
+    // and last columns take one-sided differences.
+    const float half_inv_pixel = 0.5f * inv_pixel;
+    const float* h_row = mid + box.x;
+    const float* h_up = up + box.x;
+    const float* h_down = down + box.x;
+    const float* b_row = b_mid + (box.x - region.x);
+    const float* b_row_up = b_up + (box.x - region.x);
+    const float* b_row_down = b_down + (box.x - region.x);
+    const int first = box.x == 0 ? 1 : 0;
+    const int last = box.x + width - 1 == last_col ? width - 1 : width;
+    for (int i = first; i < last; ++i) {
+      gx[i] = (h_row[i + 1] - h_row[i - 1]) * half_inv_pixel;
+      gy[i] = (h_down[i] - h_up[i]) * dy_scale;
+      hh[i] = h_row[i];
+      rim[i] = b_row[i] - h_row[i];
+      bx[i] = (b_row[i + 1] - b_row[i - 1]) * half_inv_pixel;
+      by[i] = (b_row_down[i] - b_row_up[i]) * dy_scale;
+    }
+    for (const int i : {0, width - 1}) {
+      if (i >= first && i < last) continue;
+      const int c = box.x + i;
+      const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, last_col);
+      const float dx_scale = inv_pixel / static_cast<float>(c1 - c0);
+      const int bc = c - region.x, bc0 = c0 - region.x, bc1 = c1 - region.x;
+      gx[i] = (mid[c1] - mid[c0]) * dx_scale;
+      gy[i] = (down[c] - up[c]) * dy_scale;
+      hh[i] = mid[c];
+      rim[i] = b_mid[bc] - mid[c];
+      bx[i] = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
+      by[i] = (b_down[bc] - b_up[bc]) * dy_scale;
+    }
+    // Per row and channel: coefficient of a varying feature = a + b u, a = w + w_v v.
+    const float v = (r + 0.5f) * inv_half_rows - 1.0f;
+    v_float32x4 a[3][kVarying], b[3][kVarying], fixed[3][6];
+    for (int k = 0; k < 3; ++k) {
+      for (int q = 0; q < kVarying; ++q) {
+        a[k][q] = cv::v_setall_f32(w[k][base[q]] + w[k][u_term[q] + 1] * v);
+        b[k][q] = cv::v_setall_f32(w[k][u_term[q]]);
+      }
+      for (int q = 0; q < 6; ++q) fixed[k][q] = cv::v_setall_f32(w[k][2 + q]);  // features 2-7
+    }
+    for (int i = 0; i < padded; i += kLanes) {
+      const v_float32x4 u = cv::v_setall_f32((box.x + i + 0.5f) * inv_half_cols - 1.0f) + lane_u;
+      const v_float32x4 x = cv::v_load(&gx[i]), y = cv::v_load(&gy[i]);
+      const v_float32x4 depth = cv::v_load(&hh[i]);
+      const v_float32x4 rim_v = cv::v_load(&rim[i]);
+      const v_float32x4 bxv = cv::v_load(&bx[i]), byv = cv::v_load(&by[i]);
+      const v_float32x4 varying[kVarying] = {x,
+                                             y,
+                                             cv::v_max(bxv, zero),
+                                             cv::v_max(zero - bxv, zero),
+                                             cv::v_max(byv, zero),
+                                             cv::v_max(zero - byv, zero)};
+      const v_float32x4 constant[6] = {
+          x * x, x * y, y * y, depth, cv::v_max(rim_v, zero), cv::v_min(rim_v, zero)};
+      v_float32x4 channel[3];
+      if (cv::v_check_all((x == zero) & (y == zero) & (depth == zero))) {
+        // Outside the deformation (most of the box: the rim shadow's reach) only the rim terms
+        // are non-zero; the same sums in the same order, without the zero terms.
+        for (int k = 0; k < 3; ++k) {
+          v_float32x4 acc = cv::v_fma(fixed[k][5], constant[5], fixed[k][4] * constant[4]);
+          for (int q = 2; q < kVarying; ++q) {
+            acc = cv::v_fma(cv::v_fma(b[k][q], u, a[k][q]), varying[q], acc);
+          }
+          channel[k] = acc;
+        }
+        cv::v_store_interleave(&out[3 * i], channel[0], channel[1], channel[2]);
+        continue;
+      }
+      for (int k = 0; k < 3; ++k) {
+        v_float32x4 acc = zero;
+        for (int q = 0; q < 6; ++q) acc = cv::v_fma(fixed[k][q], constant[q], acc);
+        for (int q = 0; q < kVarying; ++q) {
+          acc = cv::v_fma(cv::v_fma(b[k][q], u, a[k][q]), varying[q], acc);
+        }
+        channel[k] = acc;
+      }
+      cv::v_store_interleave(&out[3 * i], channel[0], channel[1], channel[2]);
+    }
+    std::copy_n(out, 3 * width, diff.ptr<float>(j));
+  }
+}
+
+void applyShadingResponse(const ShadingFeatureArray& features, const ShadingOptions& shading,
+                          cv::Mat3f& diff) {
+  const cv::Size size = features[0].size();
+  diff.create(size);
+  float weight[3][kShadingFeatureCount];
+  for (int k = 0; k < 3; ++k) {
+    for (int f = 0; f < kShadingFeatureCount; ++f) {
+      weight[k][f] = static_cast<float>(shading.gain * shading.response_bgr[k][f]);
+    }
+  }
+  for (int r = 0; r < size.height; ++r) {
+    const float* in[kShadingFeatureCount];
+    for (int f = 0; f < kShadingFeatureCount; ++f) in[f] = features[f].ptr<float>(r);
+    float* out = diff.ptr<float>(r);
+    for (int c = 0; c < size.width; ++c) {
+      float b = 0.0f, g = 0.0f, red = 0.0f;
+      for (int f = 0; f < kShadingFeatureCount; ++f) {
+        const float value = in[f][c];
+        b += weight[0][f] * value;
+        g += weight[1][f] * value;
+        red += weight[2][f] * value;
+      }
+      out[3 * c] = b;
+      out[3 * c + 1] = g;
+      out[3 * c + 2] = red;
+    }
+  }
+}
+
+}  // namespace norm2tex

@@ -1,0 +1,250 @@
+// norm2tex_calibrate: fits a sensor yaml to your own DIGIT from no-contact frames and a few
+// ball presses (see norm2tex/calibrate/sensor_calibration.hpp for the method).
+#include <malloc.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cli_arguments.hpp"
+#include "norm2tex/calibrate/calibration_report.hpp"
+#include "norm2tex/calibrate/sensor_calibration.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/common/image_io.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+
+namespace {
+
+using norm2tex::Error;
+using norm2tex::cli::UsageError;
+
+constexpr const char* kUsage =
+    "usage: norm2tex_calibrate --background BG.png [BG2.png ...] --presses P1.png P2.png ...\n"
+    "                          --ball-diameter-mm D [--mm-per-pixel S] [--labels labels.csv]\n"
+    "                          [--size WxH] [--sensor base.yaml] [--holdout F]\n"
+    "                          -o SENSOR.yaml [--report REPORT.png]\n"
+    "  Fits a sensor yaml to your DIGIT: scale (unless --mm-per-pixel), the calibrated shading\n"
+    "  with its rim shadow, and the noise of your no-contact frames, which become the sensor's\n"
+    "  background (written beside the yaml as <name>_background.png).\n"
+    "  --background: no-contact frames (averaged); --presses: frames of one ball press each,\n"
+    "          at different places (at least 4; 10-50 recommended), portrait as your driver\n"
+    "          publishes them.\n"
+    "  --ball-diameter-mm: the pressing ball's diameter.\n"
+    "  --mm-per-pixel: the scale, if you know it; otherwise it is fitted.\n"
+    "  --labels: CSV lines 'file,centre_x_px,centre_y_px,radius_px' (file: as given or its base\n"
+    "          name) for presses whose contact circle you know; the others are detected.\n"
+    "  --size WxH: resample every frame to this size first (e.g. 240x320 for VGA captures of a\n"
+    "          QVGA sensor). Default: the frames' own size.\n"
+    "  --sensor: the sensor yaml to start from (gel, camera); default: the built-in DIGIT.\n"
+    "  --holdout F: share of the presses held out to judge the fit (default 0.3).\n"
+    "  --report: a side-by-side image of held-out presses: real | render | difference.\n";
+
+// "--presses a b c" -> "--presses a --presses b --presses c", so that the argument parser sees
+// one value per option and shell globs just work.
+std::vector<std::string> expandLists(int argc, char** argv) {
+  std::vector<std::string> out = {argv[0]};
+  std::string list_option;
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "--background" || argument == "--presses") {
+      list_option = argument;
+      continue;
+    }
+    if (!list_option.empty() && (argument.empty() || argument[0] != '-')) {
+      out.push_back(list_option);
+      out.push_back(argument);
+      continue;
+    }
+    list_option.clear();
+    out.push_back(argument);
+  }
+  return out;
+}
+
+cv::Size parseSize(const std::string& text) {
+  int width = 0, height = 0;
+  char x = 0;
+  std::istringstream in(text);
+  if (!(in >> width >> x >> height) || x != 'x' || width < 8 || height < 8 || !in.eof()) {
+    throw UsageError("--size '" + text + "' is not valid; give WxH, e.g. 240x320");
+  }
+  return {width, height};
+}
+
+norm2tex::NamedFrame loadFrame(const std::string& path, const std::optional<cv::Size>& size) {
+  cv::Mat image = norm2tex::readImage(path, cv::IMREAD_COLOR, "frame");
+  if (size && image.size() != *size) {
+    const bool portrait = image.rows > image.cols, wanted_portrait = size->height > size->width;
+    if (portrait != wanted_portrait) {
+      throw Error("frame '" + path + "' is " + std::to_string(image.cols) + " x " +
+                  std::to_string(image.rows) + (portrait ? " (portrait)" : " (landscape)") +
+                  " but --size asks for " + std::to_string(size->width) + " x " +
+                  std::to_string(size->height) +
+                  "; rotate it the way your driver publishes frames");
+    }
+    cv::resize(image, image, *size, 0, 0, cv::INTER_AREA);
+  }
+  return {path, image};
+}
+
+// The sensor to start from, at the frames' size: the built-in DIGIT at QVGA or VGA, or
+// --sensor's model; other sizes keep the gel and scale the pixels.
+norm2tex::SensorModel baseModel(const norm2tex::cli::Arguments& args, cv::Size frame_size) {
+  if (frame_size.width > frame_size.height) {
+    throw Error("the first background frame is " + std::to_string(frame_size.width) + " x " +
+                std::to_string(frame_size.height) +
+                " (landscape) but DIGIT frames are portrait (320 rows x 240 columns as the "
+                "driver publishes them); rotate your frames the way your driver does");
+  }
+  norm2tex::SensorModel model =
+      args.has("--sensor") ? norm2tex::loadSensorModel(*args.value("--sensor"))
+                           : norm2tex::makeDigitSensorModel(frame_size == cv::Size(480, 640));
+  if (model.imageSize() != frame_size) {
+    const double factor = static_cast<double>(model.cols) / frame_size.width;
+    model.mm_per_pixel *= factor;
+    model.fx /= factor;
+    model.fy /= factor;
+    model.cols = frame_size.width;
+    model.rows = frame_size.height;
+    model.cx = 0.5 * model.cols - 0.5;
+    model.cy = 0.5 * model.rows - 0.5;
+  }
+  model.background_image.clear();
+  return model;
+}
+
+// Labels CSV: file,centre_x_px,centre_y_px,radius_px (a header line is skipped).
+std::vector<std::optional<norm2tex::PressCircle>> loadLabels(
+    const std::string& path, const std::vector<norm2tex::NamedFrame>& presses) {
+  std::ifstream file(path);
+  if (!file) throw Error("labels '" + path + "': cannot be read");
+  std::map<std::string, norm2tex::PressCircle> by_name;
+  std::string line;
+  for (int number = 1; std::getline(file, line); ++number) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream in(line);
+    std::string name, field;
+    std::vector<double> values;
+    std::getline(in, name, ',');
+    while (std::getline(in, field, ',')) {
+      try {
+        values.push_back(std::stod(field));
+      } catch (const std::exception&) {
+        values.clear();
+        break;
+      }
+    }
+    if (values.size() != 3 || !(values[2] > 0.0)) {
+      if (number == 1) continue;  // a header
+      throw Error("labels '" + path + "' line " + std::to_string(number) +
+                  ": expected 'file,centre_x_px,centre_y_px,radius_px' with radius > 0");
+    }
+    by_name[name] = norm2tex::PressCircle{{values[0], values[1]}, values[2]};
+  }
+  std::vector<std::optional<norm2tex::PressCircle>> labels(presses.size());
+  size_t used = 0;
+  for (size_t i = 0; i < presses.size(); ++i) {
+    const std::string base = std::filesystem::path(presses[i].name).filename().string();
+    for (const std::string& key : {presses[i].name, base}) {
+      if (by_name.count(key)) {
+        labels[i] = by_name[key];
+        ++used;
+        break;
+      }
+    }
+  }
+  if (used == 0) throw Error("labels '" + path + "' name none of the --presses files");
+  return labels;
+}
+
+int run(int argc, char** argv) {
+  // The fit renders thousands of presses through frame-sized temporaries. glibc hands blocks
+  // over 128 KB straight back to the kernel, and on these VMs every fresh 4 KB page costs
+  // ~13 us to fault in again; keeping freed memory in the heap makes calibration ~3x faster.
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  std::vector<std::string> expanded = expandLists(argc, argv);
+  std::vector<char*> pointers;
+  for (std::string& argument : expanded) pointers.push_back(argument.data());
+  const norm2tex::cli::Arguments args(
+      static_cast<int>(pointers.size()), pointers.data(),
+      {"--background", "--presses", "--ball-diameter-mm", "--mm-per-pixel", "--labels", "--size",
+       "--sensor", "--holdout", "-o", "--report"},
+      {"-h", "--help"});
+  if (args.flag("-h") || args.flag("--help")) {
+    std::cout << kUsage;
+    return 0;
+  }
+  if (!args.positional().empty()) {
+    throw UsageError("unexpected argument '" + args.positional().front() + "'");
+  }
+  if (!args.has("--background")) throw UsageError("missing --background");
+  if (!args.has("--presses")) throw UsageError("missing --presses");
+  if (!args.has("--ball-diameter-mm")) throw UsageError("missing --ball-diameter-mm");
+  const std::string output = args.value("-o", "");
+  if (output.empty()) throw UsageError("missing -o SENSOR.yaml");
+
+  const auto start = std::chrono::steady_clock::now();
+  std::optional<cv::Size> size;
+  if (const auto text = args.value("--size")) size = parseSize(*text);
+  norm2tex::CalibrationInput input;
+  for (const std::string& path : args.values("--background")) {
+    input.backgrounds.push_back(loadFrame(path, size));
+  }
+  for (const std::string& path : args.values("--presses")) {
+    input.presses.push_back(loadFrame(path, size));
+  }
+  input.ball_diameter_mm = args.number("--ball-diameter-mm", 0.0);
+  if (args.has("--mm-per-pixel")) input.mm_per_pixel = args.number("--mm-per-pixel", 0.0);
+  if (input.mm_per_pixel && !(*input.mm_per_pixel > 0.0 && *input.mm_per_pixel <= 1.0)) {
+    throw UsageError("--mm-per-pixel must be in (0, 1]");
+  }
+  if (const auto labels = args.value("--labels")) input.labels = loadLabels(*labels, input.presses);
+  norm2tex::CalibrationOptions options;
+  options.holdout_fraction = args.number("--holdout", options.holdout_fraction);
+
+  const norm2tex::SensorModel base = baseModel(args, input.backgrounds.front().image.size());
+  const norm2tex::CalibrationResult result = norm2tex::calibrateSensor(base, input, options);
+
+  // The background goes beside the yaml, referred to by a relative name.
+  const std::filesystem::path yaml_path(output);
+  const std::string background_name = yaml_path.stem().string() + "_background.png";
+  norm2tex::writeImage((yaml_path.parent_path() / background_name).string(), result.background);
+  norm2tex::SensorModel model = result.model;
+  model.background_image = background_name;
+  norm2tex::saveSensorModel(model, output);
+  if (const auto report = args.value("--report")) {
+    norm2tex::writeImage(*report, norm2tex::makeCalibrationReport(result));
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s: calibrated on %zu presses in %.1f s\n", output.c_str(), input.presses.size(),
+              seconds);
+  for (const std::string& line : norm2tex::describeFitQuality(result)) {
+    std::printf("  %s\n", line.c_str());
+  }
+  if (result.fit.scale_at_search_bound) {
+    std::fprintf(stderr,
+                 "norm2tex_calibrate: warning: the fitted scale (%.4f mm/px) is at the end of the "
+                 "searched range: the presses do not pin it down; measure it (a ruler pressed "
+                 "into the gel) and pass --mm-per-pixel\n",
+                 result.fit.geometry.mm_per_pixel);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return norm2tex::cli::runMain("norm2tex_calibrate", kUsage, run, argc, argv);
+}

@@ -1,0 +1,231 @@
+// Calibration of the shading to a sensor: press detection, the ball's indentation, background
+// noise measurement, a round trip through rendered presses, the real fixture presses of one
+// DIGIT, and bad input.
+#include <malloc.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "norm2tex/calibrate/background_noise.hpp"
+#include "norm2tex/calibrate/ball_press.hpp"
+#include "norm2tex/calibrate/calibration_report.hpp"
+#include "norm2tex/calibrate/press_detection.hpp"
+#include "norm2tex/calibrate/press_refinement.hpp"
+#include "norm2tex/calibrate/sensor_calibration.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/render/digit_shader_noise.hpp"
+#include "norm2tex/render/gel_model.hpp"
+#include "test_helpers.hpp"
+
+namespace norm2tex {
+namespace {
+
+constexpr double kBallRadiusMm = 3.0;
+
+// Keep freed frame-sized blocks in the heap (as norm2tex_calibrate does): the fits render
+// thousands of presses, and fresh pages cost ~13 us each on these VMs.
+const bool kHeapTuned = [] {
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  return true;
+}();
+
+// A press frame rendered by `truth`: a ball of kBallRadiusMm whose contact is `circle`.
+cv::Mat3b renderPress(const SensorModel& truth, const DigitShader& shader,
+                      const PressCircle& circle, std::int64_t seed) {
+  cv::Mat1f gel;
+  GelModel(truth).apply(ballPressIndentation(truth, circle, kBallRadiusMm), gel);
+  return shader.shade(gel, seed);
+}
+
+// Presses spread over the gel with contact radii 1.1-1.8 mm (as the real 6 mm ball set).
+std::vector<PressCircle> spreadPresses(const SensorModel& m, int count) {
+  std::vector<PressCircle> circles;
+  cv::RNG rng(7);
+  for (int i = 0; i < count; ++i) {
+    const double radius_mm = 1.1 + 0.7 * (i % 5) / 4.0;
+    const double x = rng.uniform(-4.0, 4.0), y = rng.uniform(-6.0, 6.0);
+    circles.push_back(
+        {{x / m.mm_per_pixel + 0.5 * m.cols - 0.5, y / m.mm_per_pixel + 0.5 * m.rows - 0.5},
+         radius_mm / m.mm_per_pixel});
+  }
+  return circles;
+}
+
+cv::Mat3f difference(const cv::Mat3b& frame, const cv::Mat3b& background) {
+  cv::Mat3f f, b;
+  frame.convertTo(f, CV_32F);
+  background.convertTo(b, CV_32F);
+  return f - b;
+}
+
+// Detection is the first estimate (centre within 0.2 mm, radius biased outwards by the rim
+// shadow and skirt); refinement against the model then recovers the true circle.
+TEST(PressDetection, FindsARenderedPressAndRefinementRecoversItsCircle) {
+  const SensorModel m = makeDigitSensorModel();
+  const cv::Mat3b background = makeSyntheticBackground(m.imageSize());
+  const DigitShader shader(m, background, BackgroundSource::kSynthetic);
+  for (const PressCircle& truth : spreadPresses(m, 6)) {
+    PressObservation press;
+    press.name = "rendered";
+    press.diff = difference(renderPress(m, shader, truth, 3), background);
+    press.circle = detectPress(press.diff, press.name);
+    EXPECT_LT(cv::norm(press.circle.centre_px - truth.centre_px), 0.2 / m.mm_per_pixel)
+        << truth.centre_px;
+    EXPECT_GT(press.circle.radius_px, 0.7 * truth.radius_px);
+    EXPECT_LT(press.circle.radius_px, 1.6 * truth.radius_px);
+    PressCircle start = press.circle;
+    start.radius_px /= 1.4;  // roughly the detector's bias (the fit finds it as a factor)
+    const PressCircle refined = refinePressCircle(shader, m, press, start, kBallRadiusMm);
+    EXPECT_LT(cv::norm(refined.centre_px - truth.centre_px), 0.5) << truth.centre_px;
+    EXPECT_NEAR(refined.radius_px, truth.radius_px, 0.03 * truth.radius_px) << truth.centre_px;
+  }
+}
+
+TEST(PressDetection, NoPressIsAClearError) {
+  const SensorModel m = makeDigitSensorModel();
+  const DigitShader shader(m, makeSyntheticBackground(m.imageSize()), BackgroundSource::kSynthetic);
+  const cv::Mat1f flat(m.rows, m.cols, 0.0f);
+  const cv::Mat3f noise_only = difference(shader.shade(flat, 1), shader.shade(flat, 2));
+  test::expectError([&] { detectPress(noise_only, "empty.png"); }, {"empty.png", "no press"});
+}
+
+TEST(BallPress, IndentationIsTheSphericalCapOfTheContact) {
+  SensorModel m = makeDigitSensorModel();
+  const PressCircle contact{{119.5, 159.5}, 1.5 / m.mm_per_pixel};
+  const cv::Mat1f h = ballPressIndentation(m, contact, kBallRadiusMm);
+  const double depth = kBallRadiusMm - std::sqrt(kBallRadiusMm * kBallRadiusMm - 1.5 * 1.5);
+  double peak = 0.0;
+  cv::minMaxLoc(h, nullptr, &peak);
+  EXPECT_NEAR(peak, depth, 1e-3);
+  const double area_mm2 = cv::countNonZero(h) * m.mm_per_pixel * m.mm_per_pixel;
+  EXPECT_NEAR(area_mm2, CV_PI * 1.5 * 1.5, 0.03 * CV_PI * 1.5 * 1.5);
+  test::expectError([&] { ballPressIndentation(m, contact, 1.0); }, {"ball radius", "1.5"});
+}
+
+// Noise drawn with known options over a smooth background is measured back.
+TEST(BackgroundNoise, MeasuresTheNoiseItWasGiven) {
+  const SensorModel m = makeDigitSensorModel();
+  const cv::Mat3b smooth = makeSyntheticBackground(m.imageSize());
+  const DigitShader shader(m, smooth, BackgroundSource::kSynthetic);
+  const cv::Mat1f flat(m.rows, m.cols, 0.0f);
+  std::vector<cv::Mat3b> frames;
+  for (const std::int64_t seed : {11, 12, 13}) frames.push_back(shader.shade(flat, seed));
+  const NoiseOptions measured = measureBackgroundNoise(frames);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(measured.sigma_bgr[k], m.noise.sigma_bgr[k], 0.15 * m.noise.sigma_bgr[k]) << k;
+  }
+  EXPECT_NEAR(measured.neighbour_correlation, m.noise.neighbour_correlation, 0.1);
+  EXPECT_NEAR(measured.correlation_bg, m.noise.correlation_bg, 0.08);
+  EXPECT_NEAR(measured.correlation_gr, m.noise.correlation_gr, 0.08);
+  EXPECT_NEAR(measured.correlation_br, m.noise.correlation_br, 0.08);
+  EXPECT_FALSE(measured.on_real_background);
+}
+
+// Presses rendered with a known shading model and scale are calibrated without the scale: the
+// fitted model reproduces the held-out presses and recovers the scale.
+TEST(Calibration, RoundTripRecoversTheScaleAndReproducesHeldOutPresses) {
+  const SensorModel truth = makeDigitSensorModel();  // 0.054 mm/px, the default response
+  const cv::Mat3b smooth = makeSyntheticBackground(truth.imageSize());
+  const DigitShader shader(truth, smooth, BackgroundSource::kSynthetic);
+  CalibrationInput input;
+  const cv::Mat1f flat(truth.rows, truth.cols, 0.0f);
+  input.backgrounds.push_back({"bg0", shader.shade(flat, 100)});
+  input.backgrounds.push_back({"bg1", shader.shade(flat, 101)});
+  int seed = 0;
+  for (const PressCircle& circle : spreadPresses(truth, 14)) {
+    input.presses.push_back(
+        {"press" + std::to_string(seed), renderPress(truth, shader, circle, seed)});
+    ++seed;
+  }
+  input.ball_diameter_mm = 2.0 * kBallRadiusMm;
+  SensorModel base = makeDigitSensorModel();
+  base.mm_per_pixel = 0.08;  // not used: the scale is fitted
+  const CalibrationResult result = calibrateSensor(base, input);
+  std::printf("round trip: scale %.4f mm/px (truth %.4f), held-out variance explained %.3f\n",
+              result.model.mm_per_pixel, truth.mm_per_pixel, result.held_out.variance_explained);
+  EXPECT_NEAR(result.model.mm_per_pixel, truth.mm_per_pixel, 0.05 * truth.mm_per_pixel);
+  EXPECT_GE(result.held_out.variance_explained, 0.95);
+  EXPECT_GE(result.held_out.presses, 3);
+  EXPECT_EQ(result.training_presses + result.held_out.presses, 14);
+  EXPECT_FALSE(result.fit.scale_at_search_bound);
+}
+
+NamedFrame fixtureFrame(int index) {
+  const std::string path =
+      NORM2TEX_SOURCE_DIR "/test/fixtures/digit_s09/frame_" + std::to_string(index) + ".jpg";
+  const cv::Mat3b image = cv::imread(path, cv::IMREAD_COLOR);
+  if (image.empty()) throw Error("fixture '" + path + "' is missing");
+  return {path, image};
+}
+
+// Real presses of one DIGIT (6 mm ball, 0.0532 mm/px; another session of the unit the default
+// was fitted on): calibrate on half, render the other half at the fitted geometry, compare.
+TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
+  CalibrationInput input;
+  input.backgrounds.push_back(fixtureFrame(30));
+  for (int i = 0; i <= 28; i += 2) input.presses.push_back(fixtureFrame(i));
+  input.ball_diameter_mm = 6.0;
+  input.mm_per_pixel = 0.0532;
+  CalibrationOptions options;
+  options.holdout_fraction = 0.5;
+  const CalibrationResult result = calibrateSensor(makeDigitSensorModel(), input, options);
+  const FitQuality& q = result.held_out;
+  for (const std::string& line : describeFitQuality(result)) std::printf("%s\n", line.c_str());
+  EXPECT_GE(q.presses, 7);
+  EXPECT_GE(q.variance_explained, 0.5);
+  for (int k = 0; k < 3; ++k) EXPECT_LE(q.side_error_deg[k], 30.0) << "channel " << k;
+  ASSERT_LT(q.real_rim_darkest, -3.0) << "the real presses show a rim shadow";
+  EXPECT_LE(q.sim_rim_darkest, 0.5 * q.real_rim_darkest);
+  EXPECT_NEAR(q.sim_contact_mean, q.real_contact_mean, 0.3 * q.real_contact_mean);
+  EXPECT_NEAR(q.sim_contact_p95, q.real_contact_p95, 0.3 * q.real_contact_p95);
+  // The real measures themselves are those of a DIGIT (digit_facts.md), not of noise.
+  EXPECT_GT(q.real_contact_mean, 15.0);
+  EXPECT_NEAR(q.real_side_deg[0], 70.0, 30.0);   // blue below
+  EXPECT_NEAR(q.real_side_deg[2], -41.0, 30.0);  // red upper right
+}
+
+TEST(Calibration, BadInputIsAClearError) {
+  const SensorModel m = makeDigitSensorModel();
+  const cv::Mat3b smooth = makeSyntheticBackground(m.imageSize());
+  const DigitShader shader(m, smooth, BackgroundSource::kSynthetic);
+  CalibrationInput good;
+  good.backgrounds.push_back({"bg.png", smooth});
+  int seed = 0;
+  for (const PressCircle& circle : spreadPresses(m, 5)) {
+    good.presses.push_back(
+        {"p" + std::to_string(seed) + ".png", renderPress(m, shader, circle, seed)});
+    ++seed;
+  }
+  good.ball_diameter_mm = 6.0;
+  good.mm_per_pixel = m.mm_per_pixel;
+
+  CalibrationInput landscape = good;
+  cv::transpose(landscape.presses[2].image, landscape.presses[2].image);
+  test::expectError([&] { calibrateSensor(m, landscape); }, {"p2.png", "landscape", "rotate"});
+
+  CalibrationInput no_press = good;
+  no_press.presses[1].image = smooth.clone();
+  test::expectError([&] { calibrateSensor(m, no_press); }, {"p1.png", "no press"});
+
+  CalibrationInput tiny_ball = good;
+  tiny_ball.ball_diameter_mm = 1.0;
+  test::expectError([&] { calibrateSensor(m, tiny_ball); }, {"ball", "--ball-diameter-mm"});
+
+  CalibrationInput one_press = good;
+  one_press.presses.resize(1);
+  test::expectError([&] { calibrateSensor(m, one_press); }, {"at least 4", "got 1"});
+
+  CalibrationInput no_background = good;
+  no_background.backgrounds.clear();
+  test::expectError([&] { calibrateSensor(m, no_background); }, {"background"});
+}
+
+}  // namespace
+}  // namespace norm2tex

@@ -1,0 +1,147 @@
+// Runs the real norm2tex_calibrate executable on presses rendered with a known sensor: the yaml
+// it writes loads and carries the fit, the background and report are written, labels are used,
+// and bad input is a one-line error (exit 1) or the usage (exit 2).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cli_runner.hpp"
+#include "norm2tex/calibrate/ball_press.hpp"
+#include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/render/gel_model.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+
+namespace {
+using norm2tex::test::CliRun;
+
+CliRun calibrate(const std::string& arguments) {
+  return norm2tex::test::runCommand(NORM2TEX_CALIBRATE_EXECUTABLE, arguments);
+}
+
+// Six presses of a 6 mm ball rendered by the default sensor, written as PNGs with one
+// no-contact frame; their true circles in labels.csv.
+class CalibrateCli : public norm2tex::test::CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    const norm2tex::SensorModel m = norm2tex::makeDigitSensorModel();
+    const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m.imageSize()),
+                                       norm2tex::BackgroundSource::kSynthetic);
+    const cv::Mat1f flat(m.rows, m.cols, 0.0f);
+    cv::imwrite(path("bg.png"), shader.shade(flat, 1));
+    std::ofstream labels(path("labels.csv"));
+    labels << "file,centre_x_px,centre_y_px,radius_px\n";
+    const cv::Point2d centres_mm[] = {{-3, -5}, {2, -4}, {0, 0}, {-2, 3}, {3, 4}, {1, 6}};
+    for (int i = 0; i < 6; ++i) {
+      const norm2tex::PressCircle circle{
+          {centres_mm[i].x / m.mm_per_pixel + 119.5, centres_mm[i].y / m.mm_per_pixel + 159.5},
+          (1.1 + 0.12 * i) / m.mm_per_pixel};
+      cv::Mat1f gel;
+      norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+      const std::string name = "press" + std::to_string(i) + ".png";
+      cv::imwrite(path(name), shader.shade(gel, 10 + i));
+      presses_ += " " + path(name);
+      labels << name << "," << circle.centre_px.x << "," << circle.centre_px.y << ","
+             << circle.radius_px << "\n";
+    }
+  }
+  std::string presses_;
+};
+
+TEST_F(CalibrateCli, WritesASensorYamlThatLoadsWithItsBackgroundAndAReport) {
+  const CliRun run = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                               " --ball-diameter-mm 6 --mm-per-pixel 0.054 -o " +
+                               path("mine.yaml") + " --report " + path("report.png"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("variance explained"), std::string::npos) << run.output;
+  const norm2tex::SensorModel model = norm2tex::loadSensorModel(path("mine.yaml"));
+  EXPECT_DOUBLE_EQ(model.mm_per_pixel, 0.054);
+  EXPECT_EQ(model.shading.kind, norm2tex::ShadingKind::kCalibrated);
+  EXPECT_EQ(model.background_image, path("mine_background.png"));
+  const cv::Mat background = cv::imread(model.background_image);
+  ASSERT_EQ(background.size(), cv::Size(240, 320));
+  EXPECT_LT(cv::norm(background, cv::imread(path("bg.png")), cv::NORM_INF), 1.0);
+  // The fitted response reproduces the renderer's own: same sign and similar size on the
+  // strongest coefficient of each channel.
+  const norm2tex::SensorModel truth = norm2tex::makeDigitSensorModel();
+  for (int k = 0; k < 3; ++k) {
+    int strongest = 0;
+    for (int j = 0; j < norm2tex::kShadingFeatureCount; ++j) {
+      if (std::abs(truth.shading.response_bgr[k][j]) >
+          std::abs(truth.shading.response_bgr[k][strongest])) {
+        strongest = j;
+      }
+    }
+    EXPECT_GT(model.shading.response_bgr[k][strongest] / truth.shading.response_bgr[k][strongest],
+              0.5)
+        << "channel " << k;
+  }
+  const cv::Mat report = cv::imread(path("report.png"));
+  EXPECT_EQ(report.cols, 3 * 160);
+  EXPECT_GT(report.rows, 160);
+}
+
+TEST_F(CalibrateCli, LabelsReplaceDetection) {
+  const CliRun run = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                               " --ball-diameter-mm 6 --mm-per-pixel 0.054 --labels " +
+                               path("labels.csv") + " -o " + path("labelled.yaml"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NO_THROW(norm2tex::loadSensorModel(path("labelled.yaml")));
+  std::ofstream(path("bad_labels.csv")) << "press0.png,10,20\n";
+  const CliRun bad = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                               " --ball-diameter-mm 6 --labels " + path("bad_labels.csv") + " -o " +
+                               path("x.yaml"));
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("bad_labels.csv"), std::string::npos) << bad.output;
+}
+
+TEST_F(CalibrateCli, BadInputIsAOneLineErrorOrUsage) {
+  const auto expectError = [&](const std::string& arguments, const std::string& fragment) {
+    const CliRun run = calibrate(arguments);
+    EXPECT_EQ(run.exit_code, 1) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(fragment), std::string::npos) << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  };
+  const std::string bg = " --background " + path("bg.png");
+  // Landscape frames for a portrait sensor.
+  cv::Mat landscape;
+  cv::transpose(cv::imread(path("press0.png")), landscape);
+  cv::imwrite(path("landscape.png"), landscape);
+  expectError(bg + " --presses" + presses_ + " " + path("landscape.png") +
+                  " --ball-diameter-mm 6 -o " + path("x.yaml"),
+              "landscape");
+  // A frame with no press.
+  expectError(bg + " --presses" + presses_ + " " + path("bg.png") + " --ball-diameter-mm 6 -o " +
+                  path("x.yaml"),
+              "no press");
+  // A ball too small for the contacts.
+  expectError(bg + " --presses" + presses_ + " --ball-diameter-mm 1 --mm-per-pixel 0.054 -o " +
+                  path("x.yaml"),
+              "ball");
+  // One press only.
+  expectError(
+      bg + " --presses " + path("press0.png") + " --ball-diameter-mm 6 -o " + path("x.yaml"),
+      "at least 4");
+  // A missing file is named.
+  expectError(bg + " --presses" + presses_ + " " + path("missing.png") +
+                  " --ball-diameter-mm 6 -o " + path("x.yaml"),
+              "missing.png");
+  const CliRun usage = calibrate(bg + " --presses" + presses_ + " -o " + path("x.yaml"));
+  EXPECT_EQ(usage.exit_code, 2) << usage.output;
+  EXPECT_NE(usage.output.find("--ball-diameter-mm"), std::string::npos) << usage.output;
+  EXPECT_FALSE(std::filesystem::exists(path("x.yaml")));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
