@@ -66,20 +66,7 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   if (p.variant < 0) badParameter("variant", text(p.variant), ">= 0");
   pnh.param("beta", p.beta, -1.0);
   pnh.param<std::string>("scenario", p.scenario, p.scenario);
-  pnh.param("renderers", p.renderers, p.renderers);
-  for (const std::string& name : p.renderers) {
-    if (name.empty() || name.find(' ') != std::string::npos) {
-      badParameter("renderers", "['" + name + "', ...]", "sensor names such as digit_left");
-    }
-  }
-  pnh.param("render_timeout", p.render_timeout, p.render_timeout);
-  if (!(p.render_timeout > 0.0 && p.render_timeout <= 600.0)) {
-    badParameter("render_timeout", text(p.render_timeout), "(0, 600] s");
-  }
-  pnh.param("ready_timeout", p.ready_timeout, p.ready_timeout);
-  if (!(p.ready_timeout > 0.0 && p.ready_timeout <= 3600.0)) {
-    badParameter("ready_timeout", text(p.ready_timeout), "(0, 3600] s");
-  }
+  readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
   return p;
 }
 

@@ -1,11 +1,32 @@
 #include "lock_step.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "norm2tex/common/error.hpp"
 #include "params.hpp"
 
 namespace norm2tex {
+
+void readLockStepParams(const ros::NodeHandle& pnh, std::vector<std::string>& renderers,
+                        double& render_timeout, double& ready_timeout) {
+  using ros_params::badParameter;
+  using ros_params::text;
+  pnh.param("renderers", renderers, renderers);
+  for (const std::string& name : renderers) {
+    if (name.empty() || name.find(' ') != std::string::npos) {
+      badParameter("renderers", "['" + name + "', ...]", "names such as digit_left");
+    }
+  }
+  pnh.param("render_timeout", render_timeout, render_timeout);
+  if (!(render_timeout > 0.0 && render_timeout <= 600.0)) {
+    badParameter("render_timeout", text(render_timeout), "(0, 600] s");
+  }
+  pnh.param("ready_timeout", ready_timeout, ready_timeout);
+  if (!(ready_timeout > 0.0 && ready_timeout <= 3600.0)) {
+    badParameter("ready_timeout", text(ready_timeout), "(0, 3600] s");
+  }
+}
 
 LockStep::LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> renderers,
                    double timeout, double ready_timeout, std::string owner, int window)
@@ -32,7 +53,9 @@ void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     ready_.insert(msg->sensor);  // a renderer's first message (latched) says it is ready
     const auto it = in_flight_.find(msg->frame);
-    if (it != in_flight_.end() && it->second.frame.header.stamp == msg->header.stamp &&
+    const bool listed =
+        std::find(renderers_.begin(), renderers_.end(), msg->sensor) != renderers_.end();
+    if (listed && it != in_flight_.end() && it->second.frame.header.stamp == msg->header.stamp &&
         it->second.answered.insert(msg->sensor).second) {
       ++answers_;
       if (!msg->published) {
@@ -41,11 +64,9 @@ void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
                  msg->sensor.c_str(), static_cast<unsigned long>(msg->frame),
                  msg->reason.c_str());
       }
-      // Frames leave in order once everyone has answered them.
-      while (!in_flight_.empty() && in_flight_.begin()->second.answered.size() >= renderers_.size()) {
-        bool all = true;
-        for (const std::string& r : renderers_) all = all && in_flight_.begin()->second.answered.count(r);
-        if (!all) break;
+      // Frames leave in order once every listed renderer has answered them.
+      while (!in_flight_.empty() &&
+             in_flight_.begin()->second.answered.size() == renderers_.size()) {
         in_flight_.erase(in_flight_.begin());
       }
     }

@@ -17,6 +17,12 @@
 
 namespace norm2tex {
 
+/// Reads a frame source's ~renderers (names, no spaces), ~render_timeout (0, 600] s and
+/// ~ready_timeout (0, 3600] s, keeping the given values as defaults; throws Error naming the
+/// parameter at fault.
+void readLockStepParams(const ros::NodeHandle& private_nh, std::vector<std::string>& renderers,
+                        double& render_timeout, double& ready_timeout);
+
 /// Synchronous frames for a frame source (contact_sim, probe_sim): publish a SimFrame, and have
 /// every listed renderer (or recorder) answer it on ~rendered (FrameRendered), so nothing
 /// downstream is skipped or raced. Up to `window` frames may be in flight (published, not yet

@@ -94,20 +94,7 @@ ProbeSimParams readProbeSimParams(const ros::NodeHandle& pnh) {
   if (!(p.frame_rate >= 1.0 && p.frame_rate <= 1000.0)) {
     badParameter("frame_rate", text(p.frame_rate), "[1, 1000] Hz");
   }
-  pnh.param("renderers", p.renderers, p.renderers);
-  for (const std::string& name : p.renderers) {
-    if (name.empty() || name.find(' ') != std::string::npos) {
-      badParameter("renderers", "['" + name + "', ...]", "names such as digit_left");
-    }
-  }
-  pnh.param("render_timeout", p.render_timeout, p.render_timeout);
-  if (!(p.render_timeout > 0.0 && p.render_timeout <= 600.0)) {
-    badParameter("render_timeout", text(p.render_timeout), "(0, 600] s");
-  }
-  pnh.param("ready_timeout", p.ready_timeout, p.ready_timeout);
-  if (!(p.ready_timeout > 0.0 && p.ready_timeout <= 3600.0)) {
-    badParameter("ready_timeout", text(p.ready_timeout), "(0, 3600] s");
-  }
+  readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
   pnh.param("autostart", p.autostart, p.autostart);
   pnh.param("window", p.window, p.window);
   if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
