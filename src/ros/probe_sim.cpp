@@ -228,6 +228,14 @@ bool ProbeSim::advanceFrame() {
       scenario_ = std::make_unique<ProbeScenario>(object_.mesh, params_.probe, sensor_,
                                                   block.scenario_seed);
       scenario_block_ = press.block;
+      next_texture_block_ = -1;
+      for (std::size_t p = next_press_; p < schedule_->presses().size(); ++p) {
+        const ProbeBlock& later = schedule_->blocks()[schedule_->presses()[p].block];
+        if (later.material != block.material || later.variant != block.variant) {
+          next_texture_block_ = schedule_->presses()[p].block;
+          break;
+        }
+      }
     }
     press_frames_ = scenario_->press(press.press);
     press_frames_.resize(press.frames);
@@ -289,6 +297,11 @@ bool ProbeSim::advanceFrame() {
   frame.acknowledge = lock_step_->waits();
   frame.material = block.material;
   frame.variant = static_cast<std::uint32_t>(block.variant);
+  if (next_texture_block_ >= 0) {
+    const ProbeBlock& next = schedule_->blocks()[next_texture_block_];
+    frame.next_material = next.material;
+    frame.next_variant = static_cast<std::uint32_t>(next.variant);
+  }
   frame.last = next_press_ == schedule_->presses().size() && next_in_press_ == press_frames_.size();
   ++frame_;
   missing_images_ += lock_step_->publish(frame_pub_, frame);

@@ -82,6 +82,9 @@ class ProbeSim {
   std::vector<double> block_beta_;  ///< beta label of each block, mm
   std::unique_ptr<ProbeScenario> scenario_;
   int scenario_block_ = -1;
+  /// The block whose texture comes after scenario_block_'s (-1: none): named in every SimFrame
+  /// so that renderers prepare it in the background.
+  int next_texture_block_ = -1;
   std::unique_ptr<ContactPatchMeter> meter_;
   std::size_t next_press_ = 0;
   std::vector<ProbeFrame> press_frames_;  ///< frames of the current press

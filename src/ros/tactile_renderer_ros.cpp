@@ -123,40 +123,55 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
 }
 
 void TactileRendererRos::useTexture(const TextureSource& source, const std::string& key) {
-  constexpr std::size_t kCachedTextures = 6;
-  auto cached = std::find_if(texture_cache_.begin(), texture_cache_.end(),
-                             [&](const auto& entry) { return entry.first == key; });
-  const ros::WallTime start = ros::WallTime::now();
-  if (cached == texture_cache_.end()) {
-    ObjectTexture texture = loadObjectTexture(source, *mesh_);
-    if (!texture.warning.empty()) {
-      ROS_WARN("%s: %s", params_.sensor_name.c_str(), texture.warning.c_str());
-    }
-    texture_cache_.emplace_front(key, std::move(texture));
-    if (texture_cache_.size() > kCachedTextures) texture_cache_.pop_back();
-  } else {
-    texture_cache_.splice(texture_cache_.begin(), texture_cache_, cached);
+  // On this thread, on the renderer's own mesh: a mesh without UVs is unwrapped here (once, at
+  // start-up, before any frame).
+  const ObjectTextureCache::Lookup lookup =
+      textures_.get(key, [&] { return loadObjectTexture(source, *mesh_); });
+  const ObjectTexture& texture = *lookup.texture;
+  if (!texture.warning.empty() && lookup.origin != ObjectTextureCache::Origin::kCached) {
+    ROS_WARN("%s: %s", params_.sensor_name.c_str(), texture.warning.c_str());
   }
-  const ObjectTexture& texture = texture_cache_.front().second;
   const double beta = params_.beta >= 0.0     ? params_.beta
                       : texture.beta_mm > 0.0 ? texture.beta_mm
                                               : 0.1;
   const std::string warning = renderer_->setObject(mesh_, texture.atlas, texture.atlas ? beta : 0.0);
   if (!warning.empty()) ROS_WARN("%s: %s", params_.sensor_name.c_str(), warning.c_str());
   texture_key_ = key;
-  ROS_INFO("%s: %s, beta %.3f mm, ready in %.2f s", params_.sensor_name.c_str(),
+  const char* origin = lookup.origin == ObjectTextureCache::Origin::kCached       ? "kept"
+                       : lookup.origin == ObjectTextureCache::Origin::kPrefetched ? "prepared in the background"
+                                                                                  : "prepared";
+  ROS_INFO("%s: %s, beta %.3f mm, %s, waited %.2f s", params_.sensor_name.c_str(),
            texture.atlas ? texture.description.c_str() : "no texture", texture.atlas ? beta : 0.0,
-           (ros::WallTime::now() - start).toSec());
+           origin, lookup.waited_s);
+}
+
+TextureSource TactileRendererRos::materialSource(const std::string& material,
+                                                 std::uint32_t variant) const {
+  TextureSource source;
+  source.material_config = ros_params::materialConfigPath(material);
+  source.variant = static_cast<int>(variant);
+  source.seed = static_cast<std::uint64_t>(params_.material_seed);
+  return source;
 }
 
 void TactileRendererRos::followFrameTexture(const SimFrame& frame) {
   const std::string key = frame.material + "/" + std::to_string(frame.variant);
-  if (key == texture_key_) return;
-  TextureSource source;
-  source.material_config = ros_params::materialConfigPath(frame.material);
-  source.variant = static_cast<int>(frame.variant);
-  source.seed = static_cast<std::uint64_t>(params_.material_seed);
-  useTexture(source, key);
+  if (key != texture_key_) useTexture(materialSource(frame.material, frame.variant), key);
+  if (frame.next_material.empty() || !mesh_->hasUvs()) return;
+  const std::string next_key = frame.next_material + "/" + std::to_string(frame.next_variant);
+  if (next_key == texture_key_) return;
+  TextureSource next;
+  try {
+    next = materialSource(frame.next_material, frame.next_variant);
+  } catch (const Error&) {
+    return;  // an unknown material: reported when a frame names it as its own
+  }
+  // The background works on a copy: the renderer keeps reading its mesh meanwhile.
+  std::shared_ptr<const TexturedMesh> mesh = mesh_;
+  textures_.prefetch(next_key, [next, mesh] {
+    TexturedMesh copy = *mesh;
+    return loadObjectTexture(next, copy);
+  });
 }
 
 bool TactileRendererRos::anyoneListens() const {

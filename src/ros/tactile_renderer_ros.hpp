@@ -14,6 +14,7 @@
 #include "norm2tex/FrameRendered.h"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/render/object_texture_cache.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
 
 namespace norm2tex {
@@ -64,15 +65,18 @@ class TactileRendererRos {
   bool anyoneListens() const;
   /// Loads (or takes from the cache) a texture and gives it to the renderer.
   void useTexture(const TextureSource& source, const std::string& key);
-  /// ~texture_from_frame: switches to the frame's material and variant if they differ.
+  /// ~texture_from_frame: switches to the frame's material and variant if they differ, and
+  /// starts preparing the texture the frame names as the next one.
   void followFrameTexture(const SimFrame& frame);
+  TextureSource materialSource(const std::string& material, std::uint32_t variant) const;
 
   TactileRendererParams params_;
   std::unique_ptr<TactileRenderer> renderer_;
   std::shared_ptr<TexturedMesh> mesh_;
   std::string texture_key_;  ///< "material/variant" (or the file) being rendered
-  /// The latest textures, most recent first: a dataset revisits few, and each is megabytes.
-  std::list<std::pair<std::string, ObjectTexture>> texture_cache_;
+  /// The latest textures (a dataset revisits few, and each is megabytes) and the next one,
+  /// prepared in the background.
+  ObjectTextureCache textures_{6};
   std::uint64_t rendered_ = 0, missed_ = 0;
   bool answered_any_ = false;
   std::uint64_t last_answered_frame_ = 0;

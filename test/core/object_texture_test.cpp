@@ -1,7 +1,11 @@
 // Where an object's texture comes from: a mesh's own normal texture, embedded in a GLB or a
 // file next to it, and what happens when it cannot be used.
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <future>
+#include <thread>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -10,7 +14,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/render/object_texture_cache.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
 #include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
@@ -161,6 +168,149 @@ TEST(ObjectTexture, MissingOrUnusableMeshTextureIsAWarningNamingIt) {
   TextureSource source;
   source.normal_map = dir.path("nope.png");
   test::expectError([&] { loadTextureFile(source, missing); }, {"nope.png"});
+}
+
+
+// --- ObjectTextureCache: the next texture prepared in the background --------------------------
+
+/// A texture whose description names the key, prepared in `delay_ms`; counts preparations.
+ObjectTextureCache::Prepare fakePreparation(const std::string& key, std::atomic<int>& count,
+                                            int delay_ms = 0) {
+  return [key, &count, delay_ms] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    ++count;
+    ObjectTexture texture;
+    texture.description = key;
+    texture.beta_mm = 0.1;
+    return texture;
+  };
+}
+
+TEST(ObjectTextureCache, PrefetchedTextureIsTheOneGetReturnsAndIsPreparedOnce) {
+  ObjectTextureCache cache(2);
+  std::atomic<int> count{0};
+  ASSERT_TRUE(cache.prefetch("wood/1", fakePreparation("wood/1", count, 50)));
+  EXPECT_FALSE(cache.prefetch("wood/1", fakePreparation("wood/1", count)));  // under way
+  // A second key while the first is under way is not started (one at a time).
+  EXPECT_FALSE(cache.prefetch("wood/2", fakePreparation("wood/2", count)));
+  const ObjectTextureCache::Lookup first = cache.get("wood/1", fakePreparation("wrong", count));
+  EXPECT_EQ(first.origin, ObjectTextureCache::Origin::kPrefetched);
+  EXPECT_EQ(first.texture->description, "wood/1");
+  const ObjectTextureCache::Lookup again = cache.get("wood/1", fakePreparation("wrong", count));
+  EXPECT_EQ(again.origin, ObjectTextureCache::Origin::kCached);
+  EXPECT_EQ(again.texture.get(), first.texture.get());
+  EXPECT_EQ(count.load(), 1);
+}
+
+TEST(ObjectTextureCache, GetWithoutPrefetchPreparesOnTheCallingThread) {
+  ObjectTextureCache cache(2);
+  std::atomic<int> count{0};
+  std::thread::id prepared_on;
+  const ObjectTextureCache::Lookup lookup = cache.get("rock/0", [&] {
+    prepared_on = std::this_thread::get_id();
+    return fakePreparation("rock/0", count)();
+  });
+  EXPECT_EQ(lookup.origin, ObjectTextureCache::Origin::kPrepared);
+  EXPECT_EQ(prepared_on, std::this_thread::get_id());
+  EXPECT_TRUE(cache.contains("rock/0"));
+}
+
+TEST(ObjectTextureCache, BackgroundRunsWhileTheCallerGoesOn) {
+  ObjectTextureCache cache(2);
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::thread::id prepared_on;
+  ASSERT_TRUE(cache.prefetch("fabric/3", [&, released] {
+    prepared_on = std::this_thread::get_id();
+    released.wait();  // blocks until the test lets it finish: prefetch() must not wait for it
+    ObjectTexture texture;
+    texture.description = "fabric/3";
+    return texture;
+  }));
+  EXPECT_TRUE(cache.preparing());
+  EXPECT_FALSE(cache.contains("fabric/3"));
+  release.set_value();
+  const ObjectTextureCache::Lookup lookup = cache.get("fabric/3", [] { return ObjectTexture{}; });
+  EXPECT_EQ(lookup.texture->description, "fabric/3");
+  EXPECT_NE(prepared_on, std::this_thread::get_id());
+  EXPECT_FALSE(cache.preparing());
+}
+
+TEST(ObjectTextureCache, BackgroundErrorIsThrownByGetAndNotKept) {
+  ObjectTextureCache cache(2);
+  ASSERT_TRUE(cache.prefetch("bad/0", []() -> ObjectTexture {
+    throw Error("material 'bad': no such file");
+  }));
+  try {
+    cache.get("bad/0", [] { return ObjectTexture{}; });
+    FAIL() << "expected the background's error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no such file"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(cache.contains("bad/0"));
+  EXPECT_FALSE(cache.preparing());
+  // Tried again on the next get(), on the calling thread.
+  std::atomic<int> count{0};
+  EXPECT_EQ(cache.get("bad/0", fakePreparation("bad/0", count)).origin,
+            ObjectTextureCache::Origin::kPrepared);
+  EXPECT_EQ(count.load(), 1);
+}
+
+TEST(ObjectTextureCache, KeepsTheMostRecentlyUsed) {
+  ObjectTextureCache cache(2);
+  std::atomic<int> count{0};
+  cache.get("a", fakePreparation("a", count));
+  cache.get("b", fakePreparation("b", count));
+  cache.get("a", fakePreparation("a", count));  // a is now the most recent
+  cache.get("c", fakePreparation("c", count));  // evicts b
+  EXPECT_TRUE(cache.contains("a"));
+  EXPECT_FALSE(cache.contains("b"));
+  EXPECT_TRUE(cache.contains("c"));
+  EXPECT_EQ(count.load(), 3);
+  EXPECT_THROW(ObjectTextureCache(0), Error);
+}
+
+TEST(ObjectTextureCache, PrefetchOfAKeptTextureStartsNothing) {
+  ObjectTextureCache cache(2);
+  std::atomic<int> count{0};
+  cache.get("a", fakePreparation("a", count));
+  EXPECT_FALSE(cache.prefetch("a", fakePreparation("a", count)));
+  EXPECT_FALSE(cache.preparing());
+  // A finished background texture is taken in by the next prefetch, without any get().
+  ASSERT_TRUE(cache.prefetch("b", fakePreparation("b", count)));
+  while (cache.preparing()) std::this_thread::yield();
+  EXPECT_FALSE(cache.prefetch("b", fakePreparation("b", count)));
+  EXPECT_TRUE(cache.contains("b"));
+  EXPECT_EQ(count.load(), 2);
+}
+
+TEST(ObjectTextureCache, RealMaterialPreparedInTheBackgroundEqualsOneMadeInPlace) {
+  const std::string config = std::string(NORM2TEX_SOURCE_DIR) + "/config/materials/wood.yaml";
+  auto mesh = std::make_shared<const TexturedMesh>(
+      makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02));
+  const auto prepare = [&](int variant) {
+    return [config, mesh, variant] {
+      TextureSource source;
+      source.material_config = config;
+      source.variant = variant;
+      TexturedMesh copy = *mesh;  // the background never touches the renderer's mesh
+      return loadObjectTexture(source, copy);
+    };
+  };
+  ObjectTextureCache cache(2);
+  ASSERT_TRUE(cache.prefetch("wood/5", prepare(5)));
+  const ObjectTextureCache::Lookup background = cache.get("wood/5", prepare(5));
+  EXPECT_EQ(background.origin, ObjectTextureCache::Origin::kPrefetched);
+  TexturedMesh copy = *mesh;
+  TextureSource source;
+  source.material_config = config;
+  source.variant = 5;
+  const ObjectTexture in_place = loadObjectTexture(source, copy);
+  ASSERT_TRUE(background.texture->atlas && in_place.atlas);
+  EXPECT_EQ(cv::norm(background.texture->atlas->heights(), in_place.atlas->heights(),
+                     cv::NORM_INF),
+            0.0);
+  EXPECT_EQ(background.texture->description, in_place.description);
 }
 
 }  // namespace

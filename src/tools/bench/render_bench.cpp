@@ -67,51 +67,64 @@ void BM_Render_Textured_200kTriangles(benchmark::State& state) {
   renderLoop(state, sphere(317, 317), 0.2, 1);
 }
 // The gripper's scene: the 30 mm cube held 1 mm deep, its face over the whole gel but its lower
-// edge (7 mm below the gel centre): the contact covers 3/4 of the image.
-void BM_Render_Textured_HeldCube(benchmark::State& state) {
+// edge (7 mm below the gel centre): the contact covers 3/4 of the image. `yaw` turns it about
+// the gel normal (degrees), so the face's UV axes run across the image's rows or columns.
+Eigen::Isometry3d heldCubePose(double yaw_degrees = 0.0) {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() =
+      Eigen::AngleAxisd(yaw_degrees * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   pose.translation() = Eigen::Vector3d(0.0, -0.008, 0.014);
-  renderLoop(state, std::make_shared<norm2tex::TexturedMesh>(
-                        norm2tex::makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02)),
-             0.2, 1, false, &pose);
+  return pose;
+}
+std::shared_ptr<const norm2tex::TexturedMesh> cube() {
+  return std::make_shared<norm2tex::TexturedMesh>(
+      norm2tex::makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02));
+}
+void BM_Render_Textured_HeldCube(benchmark::State& state) {
+  const Eigen::Isometry3d pose = heldCubePose(static_cast<double>(state.range(0)));
+  renderLoop(state, cube(), 0.2, 1, false, &pose);
 }
 
 // --- stages ---------------------------------------------------------------------------------
+// Argument "cube": 0 = the pressed sphere, 1 = the held cube (contact over 3/4 of the gel).
 struct StageFixture {
+  explicit StageFixture(bool held_cube = false)
+      : mesh(held_cube ? cube() : sphere(96, 192)),
+        pose(held_cube ? heldCubePose() : pressedSphere()) {
+    rasterizer.rasterize(*mesh, pose, overlay.reachMm(), true, raster);
+    overlay.apply(raster, model.gel_thickness_mm, h_final);
+    gel.apply(h_final, gel_mm);
+  }
   norm2tex::SensorModel model = norm2tex::makeDigitSensorModel();
-  std::shared_ptr<const norm2tex::TexturedMesh> mesh = sphere(96, 192);
+  std::shared_ptr<const norm2tex::TexturedMesh> mesh;
+  Eigen::Isometry3d pose;
   norm2tex::ContactRasterizer rasterizer{model};
   norm2tex::TextureOverlay overlay{atlas(), 0.2};
   norm2tex::GelModel gel{model};
   norm2tex::ContactRaster raster;
   cv::Mat1f h_final, gel_mm;
-  StageFixture() {
-    rasterizer.rasterize(*mesh, pressedSphere(), overlay.reachMm(), true, raster);
-    overlay.apply(raster, model.gel_thickness_mm, h_final);
-    gel.apply(h_final, gel_mm);
-  }
 };
 
 void BM_Stage_Raster(benchmark::State& state) {
-  StageFixture f;
-  const bool want_uv = state.range(0) != 0;
+  StageFixture f(state.range(0) != 0);
+  const bool want_uv = state.range(1) != 0;
   for (auto _ : state)
-    f.rasterizer.rasterize(*f.mesh, pressedSphere(), want_uv ? f.overlay.reachMm() : 0.0, want_uv,
+    f.rasterizer.rasterize(*f.mesh, f.pose, want_uv ? f.overlay.reachMm() : 0.0, want_uv,
                            f.raster);
 }
 void BM_Stage_Overlay(benchmark::State& state) {
-  StageFixture f;
+  StageFixture f(state.range(0) != 0);
   for (auto _ : state) f.overlay.apply(f.raster, f.model.gel_thickness_mm, f.h_final);
 }
 void BM_Stage_Gel(benchmark::State& state) {
-  StageFixture f;
+  StageFixture f(state.range(0) != 0);
   for (auto _ : state) f.gel.apply(f.h_final, f.gel_mm);
 }
 void BM_Stage_Shading(benchmark::State& state) {
-  StageFixture f;
+  StageFixture f(state.range(0) != 0);
   norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()),
                                norm2tex::BackgroundSource::kSynthetic);
-  const bool noise = state.range(0) != 0;
+  const bool noise = state.range(1) != 0;
   std::int64_t seed = 0;
   for (auto _ : state) {
     cv::Mat3b image = shader.shade(f.gel_mm, noise ? seed++ : -1);
@@ -123,10 +136,18 @@ BENCHMARK(BM_Render_Textureless)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_AtUvPole)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_200kTriangles)->Unit(benchmark::kMillisecond)->MinTime(1.0);
-BENCHMARK(BM_Render_Textured_HeldCube)->Unit(benchmark::kMillisecond)->MinTime(1.0);
-BENCHMARK(BM_Stage_Raster)->ArgName("uv")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Stage_Overlay)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Stage_Gel)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Stage_Shading)->ArgName("noise")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Render_Textured_HeldCube)
+    ->ArgName("yaw")
+    ->Arg(0)
+    ->Arg(90)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+BENCHMARK(BM_Stage_Raster)->ArgNames({"cube", "uv"})->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Overlay)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Gel)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Shading)
+    ->ArgNames({"cube", "noise"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
