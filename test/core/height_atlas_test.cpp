@@ -1,5 +1,7 @@
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -140,6 +142,44 @@ TEST(HeightAtlas, GivenIslandLabelsKeepTouchingIslandsApart) {
   cv::Mat1i wrong = labels.clone();
   wrong(0, 0) = 0;  // a valid texel without an island
   EXPECT_THROW(HeightAtlas(heights, cv::Mat1b(2, 4, 255), wrong), Error);
+}
+
+TEST(HeightAtlas, RowLookUpEqualsSingleLookUpsBitForBit) {
+  // Random heights on three islands with gaps between them; UVs anywhere (outside [0, 1] too,
+  // on texel lines, at the map's edges), some pixels not wanted; both wrap modes.
+  cv::RNG rng(7);
+  cv::Mat1f heights(37, 53);
+  rng.fill(heights, cv::RNG::UNIFORM, -1.0, 1.0);
+  cv::Mat1b valid(heights.size(), 255);
+  valid.colRange(20, 23).setTo(0);
+  valid.rowRange(10, 12).setTo(0);
+  valid(cv::Rect(40, 25, 5, 5)).setTo(0);
+  for (const UvWrap wrap : {UvWrap::kRepeat, UvWrap::kClamp}) {
+    const HeightAtlas atlas(heights, valid, wrap);
+    constexpr int kCount = 4003;  // not a multiple of 4: the scalar tail runs too
+    std::vector<cv::Vec2f> uv(kCount);
+    std::vector<unsigned char> wanted(kCount);
+    for (int i = 0; i < kCount; ++i) {
+      if (i % 7 == 0) {  // exactly on texel centres and lines
+        uv[i] = cv::Vec2f(static_cast<float>(rng.uniform(0, 54)) / 53.0f,
+                          static_cast<float>(rng.uniform(0, 38)) / 37.0f);
+      } else {
+        uv[i] = cv::Vec2f(rng.uniform(-1.5f, 2.5f), rng.uniform(-1.5f, 2.5f));
+      }
+      wanted[i] = rng.uniform(0, 5) != 0;
+    }
+    std::vector<float> row(kCount, -99.0f);
+    atlas.sampleFiniteRow(uv.data(), wanted.data(), kCount, row.data());
+    int mismatches = 0, fast = 0;
+    for (int i = 0; i < kCount; ++i) {
+      const float single = wanted[i] ? atlas.sampleFinite(uv[i][0], uv[i][1]) : 0.0f;
+      // Bit for bit, not approximately: the renderer's output must not depend on the path.
+      if (std::memcmp(&single, &row[i], sizeof(float)) != 0) ++mismatches;
+      if (wanted[i] && single != 0.0f) ++fast;
+    }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_GT(fast, kCount / 2);  // most look-ups found an island
+  }
 }
 
 TEST(HeightAtlas, RejectsEmptyOrMismatchedInput) {

@@ -72,6 +72,13 @@ class HeightAtlas {
     return sampleAcrossBorder(x0, y0, fx, fy, valid);
   }
 
+  /// sampleFinite() at `count` UVs (finite, as there), four at a time: out[i] is bit for bit
+  /// sampleFinite(uv[i]) where wanted[i] != 0, and 0 where it is 0 (not looked up). The
+  /// overlay's per-row look-up for a whole contact: the arithmetic runs in SIMD lanes, only the
+  /// texel loads stay scalar. Needs a non-empty atlas.
+  void sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
+                       float* out) const;
+
   bool empty() const { return heights_.empty(); }
   int rows() const { return heights_.rows; }
   int cols() const { return heights_.cols; }

@@ -11,23 +11,65 @@
 namespace norm2tex {
 namespace {
 
-// The pyramid runs at 1/kLowResFactor of the image resolution: its blurs are wide (0.25 to
-// 2 mm = 3 to 25 pixels at QVGA), so the low-resolution skirt loses nothing visible.
-constexpr int kLowResFactor = 4;
+// Each pyramid level runs at 1/f of the image resolution, f the largest of kFactors at which
+// its sigma still spans kMinReducedSigmaPx reduced pixels: the blurs are wide (0.1 to 0.5 mm =
+// 2 to 9 pixels at 0.054 mm/px), the blurred skirt is smooth, and a level at half resolution
+// costs an eighth (a quarter of the pixels, half the taps). The skirt is upsampled bilinearly
+// when the next level is finer; the core is restored at every resolution.
+constexpr int kFactors[] = {4, 2};
+constexpr double kMinReducedSigmaPx = 1.5;
 constexpr float kNegligibleMm = 1e-4f;
-// Levels narrower than this (in low-resolution pixels) run at full resolution instead.
-constexpr double kMinLowResSigmaPx = 1.5;
+
+int reductionFor(double sigma_px) {
+  for (const int factor : kFactors) {
+    if (sigma_px / factor >= kMinReducedSigmaPx) return factor;
+  }
+  return 1;
+}
 
 cv::Size kernelFor(double sigma_px) {
   const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_px)));
   return {2 * radius + 1, 2 * radius + 1};
 }
 
+// The helpers below are single passes over the image: the GelModel used to chain OpenCV
+// calls (compare, boundingRect, masked copies, min, masked set), a dozen full-image passes and
+// temporaries that cost about as much as the blurs.
+
+/// Bounding box of the values above kNegligibleMm (empty when none).
+cv::Rect deformationBox(const cv::Mat1f& field) {
+  int top = -1, bottom = -1, left = field.cols, right = -1;
+  for (int r = 0; r < field.rows; ++r) {
+    const float* row = field.ptr<float>(r);
+    int first = 0;
+    while (first < field.cols && !(row[first] > kNegligibleMm)) ++first;
+    if (first == field.cols) continue;
+    int last = field.cols - 1;
+    while (!(row[last] > kNegligibleMm)) --last;
+    if (top < 0) top = r;
+    bottom = r;
+    left = std::min(left, first);
+    right = std::max(right, last);
+  }
+  if (top < 0) return {};
+  return {left, top, right - left + 1, bottom - top + 1};
+}
+
+/// out = in where core is set (the contact core restored).
+void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
+  for (int r = 0; r < in.rows; ++r) {
+    const float* source = in.ptr<float>(r);
+    const uchar* mask = core.ptr<uchar>(r);
+    float* target = out.ptr<float>(r);
+    for (int c = 0; c < in.cols; ++c) target[c] = mask[c] ? source[c] : target[c];
+  }
+}
+
 /// Gaussian blur of `field` restricted to the bounding box of its non-negligible values, grown
 /// by the kernel: the rest of the image is 0 and stays 0.
 void blurAroundDeformation(double sigma_px, cv::Mat1f& field) {
   const cv::Size kernel = kernelFor(sigma_px);
-  cv::Rect box = cv::boundingRect(field > kNegligibleMm);
+  cv::Rect box = deformationBox(field);
   if (box.empty()) return;
   box.x -= kernel.width;
   box.y -= kernel.height;
@@ -53,48 +95,62 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
   }
   const cv::Mat1b core = indentation_mm > model_.gel.core_fraction * max_indentation;
 
-  // Coarse levels at low resolution, restoring the (low-resolution) core after each.
-  const cv::Size low_size(std::max(1, indentation_mm.cols / kLowResFactor),
-                          std::max(1, indentation_mm.rows / kLowResFactor));
-  const double low_mm_per_pixel = model_.mm_per_pixel * indentation_mm.cols / low_size.width;
-  std::vector<double> fine_sigmas_mm;
-  cv::Mat1f low_in, low;
-  cv::Mat1b low_core;
+  // The input and its core at the current level's resolution (factor 1: the image's own).
+  cv::Mat1f level_in;
+  cv::Mat1b level_core;
+  cv::Mat1f current;
+  int current_factor = 0;
   for (const double sigma_mm : model_.gel.pyramid_sigmas_mm) {
-    const double sigma_px = sigma_mm / low_mm_per_pixel;
-    if (sigma_px < kMinLowResSigmaPx) {
-      fine_sigmas_mm.push_back(sigma_mm);
-      continue;
+    int factor = reductionFor(sigma_mm / model_.mm_per_pixel);
+    if (current_factor > 0) factor = std::min(factor, current_factor);  // never coarser again
+    const cv::Size size(std::max(1, indentation_mm.cols / factor),
+                        std::max(1, indentation_mm.rows / factor));
+    if (factor != current_factor) {
+      if (factor == 1) {
+        level_in = indentation_mm;
+        level_core = core;
+      } else {
+        cv::resize(indentation_mm, level_in, size, 0, 0, cv::INTER_AREA);
+        cv::Mat1f core_fraction;
+        cv::resize(cv::Mat1f(core / 255), core_fraction, size, 0, 0, cv::INTER_AREA);
+        level_core = core_fraction > 0.5f;
+      }
+      if (current.empty()) {
+        current = level_in.clone();
+      } else {
+        cv::resize(current.clone(), current, size, 0, 0, cv::INTER_LINEAR);
+        restoreCore(level_in, level_core, current);
+      }
+      current_factor = factor;
     }
-    if (low.empty()) {
-      cv::resize(indentation_mm, low_in, low_size, 0, 0, cv::INTER_AREA);
-      cv::Mat1f core_fraction;
-      cv::resize(cv::Mat1f(core / 255), core_fraction, low_size, 0, 0, cv::INTER_AREA);
-      low_core = core_fraction > 0.5f;
-      low = low_in.clone();
-    }
-    cv::GaussianBlur(low, low, kernelFor(sigma_px), sigma_px, sigma_px, cv::BORDER_REPLICATE);
-    low_in.copyTo(low, low_core);
+    const double level_mm_per_pixel = model_.mm_per_pixel * indentation_mm.cols / size.width;
+    blurAroundDeformation(sigma_mm / level_mm_per_pixel, current);
+    restoreCore(level_in, level_core, current);
   }
-  if (low.empty()) {
+  if (current.empty()) {
     indentation_mm.copyTo(out);
+  } else if (current_factor > 1) {
+    cv::resize(current, out, indentation_mm.size(), 0, 0, cv::INTER_LINEAR);
+    restoreCore(indentation_mm, core, out);
   } else {
-    cv::resize(low, out, indentation_mm.size(), 0, 0, cv::INTER_LINEAR);
-    indentation_mm.copyTo(out, core);
+    current.copyTo(out);
   }
 
-  // Fine levels and the bending blur at full resolution, only where the gel moved.
-  for (const double sigma_mm : fine_sigmas_mm) {
-    blurAroundDeformation(sigma_mm / model_.mm_per_pixel, out);
-    indentation_mm.copyTo(out, core);
-  }
+  // The bending blur at full resolution, only where the gel moved.
   if (model_.gel.final_sigma_mm > 0.0) {
     blurAroundDeformation(model_.gel.final_sigma_mm / model_.mm_per_pixel, out);
   }
-  cv::min(out, model_.gel_thickness_mm, out);
-  // The blurs leave a faint tail across the whole image; below 0.1 um it is invisible (under a
-  // hundredth of a grey level) but would make every pixel "in contact" for the shader.
-  out.setTo(0.0f, out < kNegligibleMm);
+  // Clamped to the thickness. The blurs leave a faint tail across the whole image; below 0.1 um
+  // it is invisible (under a hundredth of a grey level) but would make every pixel "in contact"
+  // for the shader.
+  const float thickness = static_cast<float>(model_.gel_thickness_mm);
+  for (int r = 0; r < out.rows; ++r) {
+    float* row = out.ptr<float>(r);
+    for (int c = 0; c < out.cols; ++c) {
+      const float value = std::min(row[c], thickness);
+      row[c] = value < kNegligibleMm ? 0.0f : value;
+    }
+  }
 }
 
 }  // namespace norm2tex

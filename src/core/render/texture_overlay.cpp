@@ -2,10 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
+namespace {
+
+constexpr float kNoSurface = std::numeric_limits<float>::infinity();
+
+}  // namespace
 
 TextureOverlay::TextureOverlay(std::shared_ptr<const HeightAtlas> atlas, double beta_mm)
     : atlas_(std::move(atlas)), beta_mm_(beta_mm) {
@@ -30,21 +37,25 @@ void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv:
   const float beta = static_cast<float>(beta_mm_);
   const float thickness = static_cast<float>(thickness_mm);
   const cv::Rect box = raster.covered_box;
+  // Per row: which pixels have the surface over them, H_local there (SIMD look-up), then
+  // H_final. Reused per thread: the renderer calls this every frame.
+  thread_local std::vector<unsigned char> covered;
+  thread_local std::vector<float> heights;
+  covered.resize(box.width);
+  heights.resize(box.width);
   for (int r = box.y; r < box.y + box.height; ++r) {
-    const float* gap = raster.gap_mm.ptr<float>(r);
-    const cv::Vec2f* uv = raster.uv.ptr<cv::Vec2f>(r);
-    float* out = h_final.ptr<float>(r);
-    float* local = h_local != nullptr ? h_local->ptr<float>(r) : nullptr;
-    for (int c = box.x; c < box.x + box.width; ++c) {
-      if (!std::isfinite(gap[c])) {
-        out[c] = 0.0f;
-        if (local != nullptr) local[c] = 0.0f;
-        continue;
-      }
-      const float height = atlas_->sampleFinite(uv[c][0], uv[c][1]);
-      out[c] = std::clamp(-gap[c] + beta * height, 0.0f, thickness);
-      if (local != nullptr) local[c] = height;
+    const float* gap = raster.gap_mm.ptr<float>(r) + box.x;
+    const cv::Vec2f* uv = raster.uv.ptr<cv::Vec2f>(r) + box.x;
+    float* out = h_final.ptr<float>(r) + box.x;
+    float* local = h_local != nullptr ? h_local->ptr<float>(r) + box.x : nullptr;
+    // Branch-free, so the compiler vectorises both loops. The gap is finite or +infinity (no
+    // surface over the pixel; the rasterizer never writes NaN), and -infinity clamps to 0.
+    for (int i = 0; i < box.width; ++i) covered[i] = gap[i] < kNoSurface;
+    atlas_->sampleFiniteRow(uv, covered.data(), box.width, heights.data());
+    for (int i = 0; i < box.width; ++i) {
+      out[i] = std::min(std::max(beta * heights[i] - gap[i], 0.0f), thickness);
     }
+    if (local != nullptr) std::copy_n(heights.data(), box.width, local);
   }
 }
 

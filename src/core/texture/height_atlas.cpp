@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include <opencv2/core/hal/intrin.hpp>
+
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
 
@@ -85,6 +87,68 @@ void HeightAtlas::finish() {
     }
   }
 }
+void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
+                                  float* out) const {
+  using cv::v_float32x4;
+  using cv::v_int32x4;
+  const v_float32x4 zero = cv::v_setzero_f32(), one = cv::v_setall_f32(1.0f);
+  const v_float32x4 half = cv::v_setall_f32(0.5f);
+  const v_float32x4 cols = cv::v_setall_f32(static_cast<float>(heights_.cols));
+  const v_float32x4 rows = cv::v_setall_f32(static_cast<float>(heights_.rows));
+  const bool repeat = wrap_ == UvWrap::kRepeat;
+  const std::size_t row_step = heights_.step1();
+  alignas(16) int x0[4], y0[4];
+  alignas(16) float fx[4], fy[4];
+  float t00[4], t01[4], t10[4], t11[4];
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    v_float32x4 u, v;
+    cv::v_load_deinterleave(reinterpret_cast<const float*>(uv + i), u, v);
+    // The same operations in the same order as sampleFinite(), so the results are equal.
+    if (repeat) {
+      u = u - cv::v_cvt_f32(cv::v_floor(u));
+      v = v - cv::v_cvt_f32(cv::v_floor(v));
+    } else {
+      u = cv::v_min(cv::v_max(u, zero), one);
+      v = cv::v_min(cv::v_max(v, zero), one);
+    }
+    const v_float32x4 x = u * cols - half;
+    const v_float32x4 y = (one - v) * rows - half;
+    const v_int32x4 xi = cv::v_floor(x), yi = cv::v_floor(y);
+    cv::v_store(x0, xi);
+    cv::v_store(y0, yi);
+    const v_float32x4 wx = x - cv::v_cvt_f32(xi), wy = y - cv::v_cvt_f32(yi);
+    cv::v_store(fx, wx);
+    cv::v_store(fy, wy);
+    unsigned slow = 0;  // lanes off the fast path: bit k
+    for (int k = 0; k < 4; ++k) {
+      if (wanted[i + k] && x0[k] >= 0 && y0[k] >= 0 && x0[k] + 1 < heights_.cols &&
+          y0[k] + 1 < heights_.rows && interior_(y0[k], x0[k])) {
+        const float* top = heights_.ptr<float>(y0[k]) + x0[k];
+        t00[k] = top[0];
+        t01[k] = top[1];
+        t10[k] = top[row_step];
+        t11[k] = top[row_step + 1];
+      } else {
+        t00[k] = t01[k] = t10[k] = t11[k] = 0.0f;
+        slow |= 1u << k;
+      }
+    }
+    // Built from the scalars, not loaded from the arrays just written (a vector load of four
+    // scalar stores stalls on store forwarding).
+    const auto lanes = [](const float* t) { return v_float32x4(t[0], t[1], t[2], t[3]); };
+    const v_float32x4 result = (one - wy) * ((one - wx) * lanes(t00) + wx * lanes(t01)) +
+                               wy * ((one - wx) * lanes(t10) + wx * lanes(t11));
+    cv::v_store(out + i, result);
+    for (int k = 0; slow != 0; ++k, slow >>= 1) {
+      if (slow & 1u) {
+        out[i + k] = wanted[i + k] ? sampleAcrossBorder(x0[k], y0[k], fx[k], fy[k], nullptr) : 0.0f;
+      }
+    }
+  }
+  for (; i < count; ++i) out[i] = wanted[i] ? sampleFinite(uv[i][0], uv[i][1]) : 0.0f;
+}
+
 float HeightAtlas::sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const {
   if (valid != nullptr) *valid = false;
   const int cols[2] = {wrapIndex(x0, heights_.cols), wrapIndex(x0 + 1, heights_.cols)};
