@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <rosbag/exceptions.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -26,6 +27,15 @@ struct MessageTag {
 
 bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+/// Free space (MB) for an unprivileged writer on the file system holding `dir`; infinite when
+/// it cannot be told.
+double freeMegabytes(const std::string& dir) {
+  std::error_code ec;
+  const std::filesystem::space_info space = std::filesystem::space(dir, ec);
+  if (ec) return std::numeric_limits<double>::infinity();
+  return static_cast<double>(space.available) / 1e6;
 }
 
 }  // namespace
@@ -54,6 +64,10 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
   pnh.param("split_mb", p.split_mb, p.split_mb);
   if (!(p.split_mb >= 0.0)) badParameter("split_mb", text(p.split_mb), ">= 0 MB (0: one bag)");
+  pnh.param("min_free_mb", p.min_free_mb, p.min_free_mb);
+  if (!(p.min_free_mb >= 0.0)) {
+    badParameter("min_free_mb", text(p.min_free_mb), ">= 0 MB (0: write until a write fails)");
+  }
   return p;
 }
 
@@ -68,6 +82,11 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
                 (ec ? ": " + ec.message() : std::string()));
   }
   std::filesystem::remove(probe, ec);
+  free_mb_ = freeMegabytes(params_.output_dir);
+  if (params_.min_free_mb > 0.0 && free_mb_ < params_.min_free_mb) {
+    throw Error("output directory '" + params_.output_dir + "' has " + text(free_mb_) +
+                " MB free, under ~min_free_mb = " + text(params_.min_free_mb) + " MB");
+  }
   openNextBag();
 
   answer_pub_ = nh_.advertise<FrameRendered>(params_.answer_topic, 100, /*latch=*/true);
@@ -179,6 +198,21 @@ bool DatasetRecorder::write(const std::string& topic,
                             const std::function<void(const ros::Time&)>& write_message) {
   ++received_[topic];
   if (done_) return false;
+  // A full disk would leave a bag without its index (unreadable until `rosbag reindex`): stop
+  // while the index and the manifest still fit. Checked every 8 writes (~2 frames, ~1 MB).
+  if (params_.min_free_mb > 0.0 && ++writes_since_space_check_ >= 8) {
+    writes_since_space_check_ = 0;
+    free_mb_ = freeMegabytes(params_.output_dir);
+    if (free_mb_ < params_.min_free_mb && error_.empty()) {
+      error_ = "the disk of '" + params_.output_dir + "' is nearly full: " + text(free_mb_) +
+               " MB free, under ~min_free_mb = " + text(params_.min_free_mb) +
+               " MB; recording stopped, the bag is closed with the frames written so far";
+      ROS_ERROR("dataset_recorder: %s", error_.c_str());
+      stop_reason_ = "disk_full";
+      done_ = true;
+      return false;
+    }
+  }
   ros::Time when = ros::Time::now();
   if (when < ros::TIME_MIN) when = ros::TIME_MIN;  // bags cannot hold time 0
   try {
@@ -284,7 +318,15 @@ void DatasetRecorder::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
   if (stop_reason_.empty()) stop_reason_ = reason;
-  if (bag_) bag_->close();  // writes the index: `rosbag info` reads it
+  try {
+    if (bag_) bag_->close();  // writes the index: `rosbag info` reads it
+  } catch (const rosbag::BagException& e) {
+    // The disk filled up under min_free_mb (or it is 0): the chunks are there, the index not.
+    const std::string why = std::string("closing ") + bag_paths_.back() + " failed: " + e.what() +
+                            "; `rosbag reindex` recovers the frames written";
+    error_ = error_.empty() ? why : error_ + "; " + why;
+    ROS_ERROR("dataset_recorder: %s", why.c_str());
+  }
   const std::string path = params_.output_dir + "/" + params_.prefix + "_shard" +
                            std::to_string(params_.shard) + ".yaml";
   std::ofstream manifest(path);

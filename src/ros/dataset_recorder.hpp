@@ -28,6 +28,10 @@ struct DatasetRecorderParams {
   std::string compression = "lz4";  ///< ~compression: lz4 | bz2 | none
   int samples = 0;                  ///< ~samples: tactile images to record, then exit; 0 = no limit
   double split_mb = 0.0;            ///< ~split_mb: start a new bag past this size; 0 = one bag
+  /// ~min_free_mb: recording ends (stop_reason disk_full, an error in the manifest) when the
+  /// output file system has less free space than this, so the bag's index and the manifest
+  /// still fit: the bag stays valid. 0 = write until a write fails.
+  double min_free_mb = 64.0;
   /// ~answer_as: the name it answers synchronous frames under (list it in contact_sim's
   /// ~renderers); "" = never answer.
   std::string answer_as = "recorder";
@@ -98,6 +102,9 @@ class DatasetRecorder {
   std::string stop_reason_;
   std::uint64_t images_ = 0;
   bool done_ = false, closed_ = false;
+  /// Free space (MB) of the output file system at the last check, and writes since then.
+  double free_mb_ = 0.0;
+  int writes_since_space_check_ = 0;
   std::string error_;
   ros::WallTime started_, last_progress_;
 

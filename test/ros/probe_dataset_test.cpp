@@ -241,6 +241,45 @@ TEST_F(ProbeDataset, SplitBagsAreEachValidAndTogetherHoldEveryFrame) {
   }
 }
 
+TEST_F(ProbeDataset, AFullDiskEndsRecordingWithAClearErrorAndAValidBag) {
+  // A 24 MB file system (tmpfs) holds ~40 frames of 0.5 MB; the recorder stops with 8 MB left.
+  const fs::path mount_point = scratch() / "small_disk";
+  fs::create_directories(mount_point);
+  std::string output;
+  if (test::runCommand("mount -t tmpfs -o size=24m norm2tex_test " + mount_point.string(),
+                       output) != 0) {
+    GTEST_SKIP() << "SKIPPED: cannot mount a small tmpfs here (needs root): " << output;
+  }
+  struct Unmount {
+    fs::path at;
+    ~Unmount() {
+      std::string ignored;
+      test::runCommand("umount " + at.string(), ignored);
+    }
+  } unmount{mount_point};
+  const fs::path dir = record("small_disk/out", "seed:=3 samples:=200 min_free_mb:=8");
+  const std::string manifest = readFile(dir / "norm2tex_shard0.yaml");
+  EXPECT_NE(manifest.find("stop_reason: disk_full"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("complete: false"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("is nearly full"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find(dir.string()), std::string::npos) << "the error names the directory";
+  // The bag is closed and indexed: rosbag reads it, and the reader finds the frames written.
+  const std::vector<std::string> bags = bagsIn(dir);
+  ASSERT_EQ(bags.size(), 1u);
+  std::string info;
+  EXPECT_EQ(test::runCommand("rosbag info " + bags[0], info), 0) << info;
+  const std::size_t images_at = manifest.find("images: ");
+  ASSERT_NE(images_at, std::string::npos);
+  const int images = std::stoi(manifest.substr(images_at + 8));
+  EXPECT_GE(images, 10);
+  EXPECT_LT(images, 80);  // it stopped long before the 4 x 200 frames asked for
+  const std::map<ros::Time, Frame> frames = framesOf(dir);
+  // Every image written is read back; the last frame may lack parts written after the stop.
+  EXPECT_GE(static_cast<int>(frames.size()), images - 1);
+  EXPECT_LE(static_cast<int>(frames.size()), images);
+  for (const auto& [stamp, f] : frames) EXPECT_FALSE(f.sample.image.empty()) << stamp;
+}
+
 TEST_F(ProbeDataset, ExportRoundTripsFramesLabelsAndBackgroundSubtraction) {
   ExportOptions options;
   options.out_dir = (scratch() / "export").string();
