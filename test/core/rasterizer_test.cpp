@@ -85,6 +85,11 @@ TEST(ContactRasterizer, FinelyTessellatedPlaneCoversEveryPixelExactlyOnce) {
                               "120x120 quads, turned");
   expectEveryPixelExactlyOnce(makeGrid(700, 40.0, 0.2, model), pressedAndTurned(0.5, 0.11), model,
                               "700x700 sub-pixel quads");
+  // Wide triangles (quads of ~90 pixels), whose rows are filled by closed-form spans.
+  expectEveryPixelExactlyOnce(makeGrid(8, 40.0, 0.2, model), pressedAndTurned(0.5, 0.0), model,
+                              "8x8 wide quads");
+  expectEveryPixelExactlyOnce(makeGrid(8, 40.0, 0.2, model), pressedAndTurned(0.5, 0.37), model,
+                              "8x8 wide quads, turned");
 }
 
 TEST(ContactRasterizer, CentresExactlyOnEdgesAndCornersAreDrawnOnce) {
@@ -98,6 +103,13 @@ TEST(ContactRasterizer, CentresExactlyOnEdgesAndCornersAreDrawnOnce) {
   flipped.rotate(Eigen::AngleAxisd(CV_PI, Eigen::Vector3d::UnitX()));
   expectEveryPixelExactlyOnce(makeGrid(60, 30.0, 0.0, model, true), flipped, model,
                               "vertices on pixel centres, flipped");
+  // Wide triangles (~90 pixels a side): the closed-form row spans obey the same fill rule.
+  for (const double yaw : {0.0, CV_PI / 2, CV_PI}) {
+    expectEveryPixelExactlyOnce(makeGrid(6, 30.0, 0.0, model, true), pressedAndTurned(0.5, yaw),
+                                model, "wide triangles on pixel centres, yaw " + std::to_string(yaw));
+  }
+  expectEveryPixelExactlyOnce(makeGrid(6, 30.0, 0.0, model, true), flipped, model,
+                              "wide triangles on pixel centres, flipped");
 }
 
 TEST(ContactRasterizer, TwoThreadsSharingOneRasterizerGiveTheSameRastersAsOne) {

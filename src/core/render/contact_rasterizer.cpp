@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "norm2tex/common/error.hpp"
 
@@ -167,6 +168,12 @@ bool fillTriangle(const T* x, const T* y, T one_pixel, const ProjectedTriangle& 
   const float z[3] = {triangle.z[i0], triangle.z[i1], triangle.z[i2]};
   const Eigen::Vector2f uv[3] = {triangle.uv[i0], triangle.uv[i1], triangle.uv[i2]};
   const double inverse_area = 1.0 / static_cast<double>(area);
+  // Wide triangles get each row's span in closed form (three integer divisions per row, then no
+  // test per pixel); narrow ones, a few pixels a row (a fine mesh), are cheaper tested per
+  // pixel. Doubles (corners beyond the fixed-point range) are always tested per pixel.
+  constexpr int kMinSpanColumns = 12;
+  const bool test_each_pixel =
+      !std::is_integral_v<T> || range.c_end - range.c_begin + 1 < kMinSpanColumns;
   for (int r = range.r_begin; r <= range.r_end; ++r) {
     float* gap_row = out.gap_mm.ptr<float>(r);
     int* face_row = out.face.ptr<int>(r);
@@ -179,9 +186,34 @@ bool fillTriangle(const T* x, const T* y, T one_pixel, const ProjectedTriangle& 
       e[k] = edges[k].at(static_cast<T>(range.c_begin) * one_pixel, py);
       step[k] = -edges[k].dy * one_pixel;
     }
-    for (int col = range.c_begin; col <= range.c_end;
+    int c_first = range.c_begin, c_last = range.c_end;
+    if (!test_each_pixel) {
+      // The row's covered columns in closed form, exactly those the per-pixel test accepts: each
+      // edge function is linear in the column, so it bounds the span from one side.
+      for (int k = 0; k < 3 && c_first <= c_last; ++k) {
+        const T e0 = e[k], s = step[k];
+        const bool owns = edges[k].owns_boundary;
+        if (s == 0) {
+          if (!edges[k].inside(e0)) c_first = c_last + 1;
+        } else if (s > 0) {  // inside from some column on
+          const T n = edges[k].inside(e0) ? 0 : owns ? ceilDiv(-e0, s) : floorDiv(-e0, s) + 1;
+          c_first = static_cast<int>(
+              std::min<T>(std::max<T>(c_first, range.c_begin + n), static_cast<T>(c_last) + 1));
+        } else {  // inside up to some column
+          const T n = owns ? floorDiv(e0, -s) : ceilDiv(e0, -s) - 1;
+          c_last = static_cast<int>(
+              std::max<T>(std::min<T>(c_last, range.c_begin + n), static_cast<T>(c_first) - 1));
+        }
+      }
+      if (c_first > c_last) continue;
+      for (int k = 0; k < 3; ++k) e[k] += static_cast<T>(c_first - range.c_begin) * step[k];
+    }
+    for (int col = c_first; col <= c_last;
          ++col, e[0] += step[0], e[1] += step[1], e[2] += step[2]) {
-      if (!edges[0].inside(e[0]) || !edges[1].inside(e[1]) || !edges[2].inside(e[2])) continue;
+      if (test_each_pixel &&
+          (!edges[0].inside(e[0]) || !edges[1].inside(e[1]) || !edges[2].inside(e[2]))) {
+        continue;
+      }
       ++out.pixel_hits;
       const float w0 = static_cast<float>(static_cast<double>(e[0]) * inverse_area);
       const float w1 = static_cast<float>(static_cast<double>(e[1]) * inverse_area);
