@@ -77,6 +77,18 @@ TEST(MaterialTexture, PeriodInMillimetresIsTheSameOnFacesOfDifferentUvScale) {
   EXPECT_NEAR(texels_per_period[2] / texels_per_period[1], 2.0, 0.1);
 }
 
+TEST(MaterialTexture, WithoutAlbedoTheReliefAndNormalsAreTheSame) {
+  const auto material = makeMaterial("wood");
+  const UvLayout layout = computeUvLayout(twoQuadsOfDifferentUvScale(), cv::Size(256, 256));
+  const MaterialTexture full = renderMaterialTexture(*material, layout, CV_16U, 4);
+  const MaterialTexture relief = renderMaterialTexture(*material, layout, CV_16U, 4, false);
+  EXPECT_TRUE(relief.albedo.empty());
+  ASSERT_FALSE(full.albedo.empty());
+  EXPECT_EQ(cv::norm(full.height_mm, relief.height_mm, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(full.normal_map, relief.normal_map, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(full.valid != relief.valid), 0);
+}
+
 TEST(MaterialTexture, NormalMapAlphaIsTheIslandsAndPaddingCarriesTheirNormals) {
   const auto material = makeMaterial("rock");
   const UvLayout layout = computeUvLayout(twoQuadsOfDifferentUvScale(), cv::Size(256, 256));

@@ -29,9 +29,10 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, int si
 /// has the same scale in mm on every face whatever each island's UV scale. Slopes are taken
 /// within islands only; then every island's normals and albedo are extended `padding_texels`
 /// into the empty texels around it (alpha stays 0 there), so filtering at island borders never
-/// blends in the flat background. The layout must be square.
+/// blends in the flat background. The layout must be square. `with_albedo` false leaves
+/// `albedo` empty: a bake needs only the relief, and the colour costs as much again.
 MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const UvLayout& layout,
-                                      int depth, int padding_texels);
+                                      int depth, int padding_texels, bool with_albedo = true);
 
 /// H_global of a material as it lies on `mesh`, ready for the TextureOverlay: the material
 /// (variant `variant` of the config, see makeMaterialVariant; `seed`) rendered for the mesh's UV

@@ -46,14 +46,14 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, int si
 }
 
 MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const UvLayout& layout,
-                                      int depth, int padding_texels) {
+                                      int depth, int padding_texels, bool with_albedo) {
   const cv::Size extent = layout.island.size();
   if (extent.width != extent.height || extent.width < 2) {
     throw Error("renderMaterialTexture: the UV layout must be square");
   }
   MaterialTexture texture;
   texture.height_mm = cv::Mat1f(extent, 0.0f);
-  texture.albedo = cv::Mat3b(extent, cv::Vec3b(0, 0, 0));
+  if (with_albedo) texture.albedo = cv::Mat3b(extent, cv::Vec3b(0, 0, 0));
   texture.valid = layout.island > 0;
   texture.mm_per_texel = cv::Mat1f(extent, 0.0f);
   // Bounding box of each island, to evaluate the material only where that island lies.
@@ -75,7 +75,9 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
     const cv::Point2d origin(box.x * mm_per_texel, box.y * mm_per_texel);
     const cv::Mat1b mask = layout.island(box) == id;
     material.renderHeightMm(box.size(), mm_per_texel, origin).copyTo(texture.height_mm(box), mask);
-    material.renderAlbedo(box.size(), mm_per_texel, origin).copyTo(texture.albedo(box), mask);
+    if (with_albedo) {
+      material.renderAlbedo(box.size(), mm_per_texel, origin).copyTo(texture.albedo(box), mask);
+    }
     texture.mm_per_texel(box).setTo(static_cast<float>(mm_per_texel), mask);
   }
   cv::Mat1f safe_resolution = texture.mm_per_texel.clone();
@@ -89,8 +91,10 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
     cv::Mat bgr;
     cv::merge(std::vector<cv::Mat>{channels[0], channels[1], channels[2]}, bgr);
     padIslands(bgr, layout.island, padding_texels);
-    cv::Mat albedo = texture.albedo;
-    padIslands(albedo, layout.island, padding_texels);
+    if (with_albedo) {
+      cv::Mat albedo = texture.albedo;
+      padIslands(albedo, layout.island, padding_texels);
+    }
     std::vector<cv::Mat> padded;
     cv::split(bgr, padded);
     padded.push_back(channels[3]);
@@ -108,8 +112,9 @@ HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, 
     mesh = unwrapUvs(mesh, options).mesh;
   }
   const auto material = makeMaterialVariant(config, variant, seed);
-  const MaterialTexture texture = renderMaterialTexture(
-      *material, computeUvLayout(mesh, cv::Size(config.size, config.size)), CV_16U, padding_texels);
+  const MaterialTexture texture =
+      renderMaterialTexture(*material, computeUvLayout(mesh, cv::Size(config.size, config.size)),
+                            CV_16U, padding_texels, /*with_albedo=*/false);
   BakeOptions options;
   options.range = config.range;
   // No relief high-pass: a procedural normal map is the exact slope of a designed height, so
