@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/gel_law.hpp"
@@ -375,6 +376,23 @@ TEST(ContactPatchTest, SphereContactGrowsWithTheSqueezeAsGeometryPredicts) {
     EXPECT_LT(patch.centroid_m.norm(), 0.2e-3);  // seated at the gel centre
     EXPECT_GT(patch.area_m2, previous_area);
     previous_area = patch.area_m2;
+  }
+}
+
+TEST(ContactPatchTest, CentroidIsWhereTheBallPressesInGelMillimetres) {
+  const SensorModel sensor = makeDigitSensorModel();
+  ContactPatchMeter meter(sensor);
+  const TexturedMesh ball = makeUvSphere(0.004, 64, 128);
+  for (const Eigen::Vector2d at : {Eigen::Vector2d(2.0e-3, -3.0e-3), Eigen::Vector2d(-4.5e-3, 5e-3)}) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(at.x(), at.y(), 0.004 - 0.6e-3);  // 0.6 mm deep
+    const ContactPatch patch = meter.measure(ball, pose);
+    ASSERT_GT(patch.pixels, 100);
+    // Symmetric footprint: its centroid is the ball's centre to well within a pixel (0.053 mm).
+    EXPECT_NEAR(patch.centroid_m.x(), at.x(), 0.02e-3);
+    EXPECT_NEAR(patch.centroid_m.y(), at.y(), 0.02e-3);
+    EXPECT_NEAR(patch.max_indentation_m, 0.6e-3, 0.01e-3);
+    EXPECT_NEAR(patch.area_m2, M_PI * (2 * 0.004 * 0.6e-3 - 0.36e-6), 0.03 * patch.area_m2);
   }
 }
 
