@@ -249,7 +249,7 @@ void DatasetRecorder::onFramePart(const std::string& topic, const ros::Time& sta
   }
   if (endsWith(topic, "/image_raw")) {
     ++images_;
-    ++images_per_label_[labelAt(stamp)];
+    image_stamps_.push_back(stamp);
     last_image_stamp_ = std::max(last_image_stamp_, stamp);
     if (params_.samples > 0 && images_ >= static_cast<std::uint64_t>(params_.samples)) {
       target_reached_ = true;
@@ -357,7 +357,9 @@ void DatasetRecorder::close(const std::string& reason) {
            << ", beta: " << episode_.beta << ", seed: " << episode_.seed << ", scenario: '"
            << episode_.scenario << "'}\n"
            << "images_per_label:\n";
-  for (const auto& [label, count] : images_per_label_) {
+  std::map<std::string, std::uint64_t> images_per_label;
+  for (const ros::Time& stamp : image_stamps_) ++images_per_label[labelAt(stamp)];
+  for (const auto& [label, count] : images_per_label) {
     manifest << "  '" << label << "': " << count << "\n";
   }
   manifest << "topics:  # received / written\n";

@@ -92,7 +92,9 @@ class DatasetRecorder {
   ros::Time last_image_stamp_;
   bool target_reached_ = false;
   std::map<ros::Time, std::uint64_t> waiting_;  ///< synchronous frames to answer, by stamp
-  std::map<std::string, std::uint64_t> images_per_label_;  ///< "material/variant" -> images
+  /// Stamps of the images written, labelled at close(): an image may arrive before the
+  /// EpisodeInfo that labels it (different topics), so labels are joined by stamp at the end.
+  std::vector<ros::Time> image_stamps_;
   EpisodeInfo episode_;  ///< the latest episode
   /// Episodes by start stamp: an image belongs to the latest episode started at or before it
   /// (topics arrive on separate connections, so arrival order is not enough).

@@ -133,6 +133,12 @@ TEST_F(ProbeDataset, EveryFrameIsALabelledContactAndNothingIsLost) {
   EXPECT_NE(manifest.find("images: 40"), std::string::npos) << manifest;
   EXPECT_NE(manifest.find("stop_reason: last_frame"), std::string::npos) << manifest;
   EXPECT_NE(manifest.find("complete: true"), std::string::npos) << manifest;
+  // Per label, joined by stamp (an image may arrive before the EpisodeInfo that labels it).
+  for (const char* label : {"wood/variant0", "wood/variant1", "fabric/variant0", "fabric/variant1"}) {
+    EXPECT_NE(manifest.find("'" + std::string(label) + "': 10\n"), std::string::npos)
+        << label << "\n" << manifest;
+  }
+  EXPECT_EQ(manifest.find("unlabelled"), std::string::npos) << manifest;
   EXPECT_NE(manifest.find("'/digit_left/image_raw': {received: 40, written: 40}"),
             std::string::npos)
       << manifest;
