@@ -255,10 +255,12 @@ void ContactSim::onTimer(const ros::WallTimerEvent&) {
     wall_anchor_ = now;
     anchor_frame_ = frame_;
   }
-  // Rounded, not floored: ticks jitter around their schedule, and a tick a little early must
-  // still step its frame (floored, every frame would come one tick late).
+  // A frame is due when the wall clock reaches its stamp, so a frame never leads the clock
+  // (stamp-to-image latencies stay meaningful); a tick up to kEarlyNs early still steps it, since
+  // timers jitter (floored exactly, an early tick would make every frame one tick late).
+  constexpr std::int64_t kEarlyNs = 1'000'000;
   const std::int64_t due =
-      anchor_frame_ + 1 + ((now - wall_anchor_).toNSec() + frame_period_ns_ / 2) / frame_period_ns_;
+      anchor_frame_ + 1 + ((now - wall_anchor_).toNSec() + kEarlyNs) / frame_period_ns_;
   int stepped = 0;
   while (frame_ < due && stepped < kMaxCatchUp) {
     advanceFrame();
