@@ -4,7 +4,6 @@
 #include <cmath>
 #include <vector>
 
-#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
@@ -66,6 +65,139 @@ void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, 
   if (factor > 1) cv::resize(small, full, snapped.size(), 0, 0, cv::INTER_LINEAR);
   full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).copyTo(out);
 }
+
+// The per-pixel sums of the fused shading over one row (computeShadingDifference): plain loops
+// that the compiler vectorises. With GCC or Clang on x86-64 the loop is built twice, for AVX2
+// with FMA (8 pixels a step, fused multiply-adds) and for the x86-64 baseline (SSE2, 4 pixels),
+// and the CPU picks one when the library loads (a feature test, not a CPU model: new CPUs get
+// AVX2 too). The two agree to float rounding (an FMA rounds once).
+constexpr int kVarying = 6;   // slope_x, slope_y, rim_right, rim_left, rim_down, rim_up
+constexpr int kConstant = 6;  // slope_xx, slope_xy, slope_yy, depth, rim_out, rim_in
+
+/// Per row and channel: the coefficient of varying feature q is a[c][q] + b[c][q] u.
+struct RowCoefficients {
+  float a[3][kVarying], b[3][kVarying], fixed[3][kConstant];
+};
+
+#if defined(__GNUC__)
+#define NORM2TEX_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define NORM2TEX_ALWAYS_INLINE inline
+#endif
+
+NORM2TEX_ALWAYS_INLINE void shadeRowBody(int n, const float* __restrict gx,
+                                         const float* __restrict gy, const float* __restrict hh,
+                                         const float* __restrict rim, const float* __restrict bx,
+                                         const float* __restrict by, float u0, float du,
+                                         const RowCoefficients& k, float* __restrict out_b,
+                                         float* __restrict out_g, float* __restrict out_r) {
+  for (int i = 0; i < n; ++i) {
+    const float u = u0 + static_cast<float>(i) * du;
+    const float x = gx[i], y = gy[i];
+    const float varying[kVarying] = {x,
+                                     y,
+                                     std::max(bx[i], 0.0f),
+                                     std::max(-bx[i], 0.0f),
+                                     std::max(by[i], 0.0f),
+                                     std::max(-by[i], 0.0f)};
+    const float constant[kConstant] = {x * x, x * y, y * y, hh[i], std::max(rim[i], 0.0f),
+                                       std::min(rim[i], 0.0f)};
+    // Unrolled, so that the loop over pixels is the one vectorised.
+    float acc[3] = {0.0f, 0.0f, 0.0f};
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 6
+      for (int q = 0; q < kConstant; ++q) acc[c] += k.fixed[c][q] * constant[q];
+#pragma GCC unroll 6
+      for (int q = 0; q < kVarying; ++q) acc[c] += (k.a[c][q] + k.b[c][q] * u) * varying[q];
+    }
+    out_b[i] = acc[0];
+    out_g[i] = acc[1];
+    out_r[i] = acc[2];
+  }
+}
+
+/// Interior columns [first, last) of one row: central differences of H and of its blur B, the
+/// depth and B - H (no clamping, so the loop vectorises; the image's border columns are done
+/// apart).
+NORM2TEX_ALWAYS_INLINE void differencesBody(int first, int last, const float* __restrict h_row,
+                                            const float* __restrict h_up,
+                                            const float* __restrict h_down,
+                                            const float* __restrict b_row,
+                                            const float* __restrict b_up,
+                                            const float* __restrict b_down, float half_inv_pixel,
+                                            float dy_scale, float* __restrict gx,
+                                            float* __restrict gy, float* __restrict hh,
+                                            float* __restrict rim, float* __restrict bx,
+                                            float* __restrict by) {
+  for (int i = first; i < last; ++i) {
+    gx[i] = (h_row[i + 1] - h_row[i - 1]) * half_inv_pixel;
+    gy[i] = (h_down[i] - h_up[i]) * dy_scale;
+    hh[i] = h_row[i];
+    rim[i] = b_row[i] - h_row[i];
+    bx[i] = (b_row[i + 1] - b_row[i - 1]) * half_inv_pixel;
+    by[i] = (b_down[i] - b_up[i]) * dy_scale;
+  }
+}
+
+using Differences = void (*)(int, int, const float*, const float*, const float*, const float*,
+                             const float*, const float*, float, float, float*, float*, float*,
+                             float*, float*, float*);
+
+void differencesBaseline(int first, int last, const float* h_row, const float* h_up,
+                         const float* h_down, const float* b_row, const float* b_up,
+                         const float* b_down, float half_inv_pixel, float dy_scale, float* gx,
+                         float* gy, float* hh, float* rim, float* bx, float* by) {
+  differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel,
+                  dy_scale, gx, gy, hh, rim, bx, by);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+__attribute__((target("avx2,fma"))) void differencesAvx2(
+    int first, int last, const float* h_row, const float* h_up, const float* h_down,
+    const float* b_row, const float* b_up, const float* b_down, float half_inv_pixel,
+    float dy_scale, float* gx, float* gy, float* hh, float* rim, float* bx, float* by) {
+  differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel,
+                  dy_scale, gx, gy, hh, rim, bx, by);
+}
+#endif
+
+using ShadeRow = void (*)(int, const float*, const float*, const float*, const float*,
+                          const float*, const float*, float, float, const RowCoefficients&,
+                          float*, float*, float*);
+
+void shadeRowBaseline(int n, const float* gx, const float* gy, const float* hh, const float* rim,
+                      const float* bx, const float* by, float u0, float du,
+                      const RowCoefficients& k, float* out_b, float* out_g, float* out_r) {
+  shadeRowBody(n, gx, gy, hh, rim, bx, by, u0, du, k, out_b, out_g, out_r);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+__attribute__((target("avx2,fma"))) void shadeRowAvx2(int n, const float* gx, const float* gy,
+                                                      const float* hh, const float* rim,
+                                                      const float* bx, const float* by, float u0,
+                                                      float du, const RowCoefficients& k,
+                                                      float* out_b, float* out_g, float* out_r) {
+  shadeRowBody(n, gx, gy, hh, rim, bx, by, u0, du, k, out_b, out_g, out_r);
+}
+#endif
+
+bool hasAvx2() {
+#if defined(__GNUC__) && defined(__x86_64__)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+  return false;
+#endif
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+const ShadeRow shadeRow = hasAvx2() ? shadeRowAvx2 : shadeRowBaseline;
+const Differences differences = hasAvx2() ? differencesAvx2 : differencesBaseline;
+#else
+const ShadeRow shadeRow = shadeRowBaseline;
+const Differences differences = differencesBaseline;
+#endif
 
 }  // namespace
 
@@ -190,26 +322,28 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
   }
   // Base features whose coefficient varies with the position: slope_x, slope_y, rim_right,
   // rim_left, rim_down, rim_up, with their u- and v-terms.
-  constexpr int kVarying = 6;
   const int base[kVarying] = {0, 1, 8, 9, 10, 11};
   const int u_term[kVarying] = {12, 14, 16, 18, 20, 22};
 
-  constexpr int kLanes = 4;
   const int width = box.width;
-  const int padded = (width + kLanes - 1) / kLanes * kLanes;
-  // Row buffers, padded so that the last SIMD step may read past the box; reused per thread.
+  // Row buffers, reused per thread.
   thread_local std::vector<float> rows_scratch;
-  rows_scratch.assign(9 * padded, 0.0f);
+  rows_scratch.resize(9 * static_cast<std::size_t>(width));
   float* gx = rows_scratch.data();
-  float* gy = gx + padded;
-  float* hh = gy + padded;
-  float* rim = hh + padded;
-  float* bx = rim + padded;
-  float* by = bx + padded;
-  float* out = by + padded;
-  using cv::v_float32x4;
-  const v_float32x4 zero = cv::v_setzero_f32();
-  const v_float32x4 lane_u(0.0f, inv_half_cols, 2.0f * inv_half_cols, 3.0f * inv_half_cols);
+  float* gy = gx + width;
+  float* hh = gy + width;
+  float* rim = hh + width;
+  float* bx = rim + width;
+  float* by = bx + width;
+  float* out_b = by + width;
+  float* out_g = out_b + width;
+  float* out_r = out_g + width;
+  RowCoefficients k;
+  for (int c = 0; c < 3; ++c) {
+    for (int q = 0; q < kConstant; ++q) k.fixed[c][q] = w[c][2 + q];  // features 2-7
+    for (int q = 0; q < kVarying; ++q) k.b[c][q] = w[c][u_term[q]];
+  }
+  const float u0 = (box.x + 0.5f) * inv_half_cols - 1.0f;
 
   for (int j = 0; j < box.height; ++j) {
     const int r = box.y + j;
@@ -232,14 +366,8 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
     const float* b_row_down = b_down + (box.x - region.x);
     const int first = box.x == 0 ? 1 : 0;
     const int last = box.x + width - 1 == last_col ? width - 1 : width;
-    for (int i = first; i < last; ++i) {
-      gx[i] = (h_row[i + 1] - h_row[i - 1]) * half_inv_pixel;
-      gy[i] = (h_down[i] - h_up[i]) * dy_scale;
-      hh[i] = h_row[i];
-      rim[i] = b_row[i] - h_row[i];
-      bx[i] = (b_row[i + 1] - b_row[i - 1]) * half_inv_pixel;
-      by[i] = (b_row_down[i] - b_row_up[i]) * dy_scale;
-    }
+    differences(first, last, h_row, h_up, h_down, b_row, b_row_up, b_row_down, half_inv_pixel,
+                dy_scale, gx, gy, hh, rim, bx, by);
     for (const int i : {0, width - 1}) {
       if (i >= first && i < last) continue;
       const int c = box.x + i;
@@ -253,55 +381,13 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
       bx[i] = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
       by[i] = (b_down[bc] - b_up[bc]) * dy_scale;
     }
-    // Per row and channel: coefficient of a varying feature = a + b u, a = w + w_v v.
     const float v = (r + 0.5f) * inv_half_rows - 1.0f;
-    v_float32x4 a[3][kVarying], b[3][kVarying], fixed[3][6];
-    for (int k = 0; k < 3; ++k) {
-      for (int q = 0; q < kVarying; ++q) {
-        a[k][q] = cv::v_setall_f32(w[k][base[q]] + w[k][u_term[q] + 1] * v);
-        b[k][q] = cv::v_setall_f32(w[k][u_term[q]]);
-      }
-      for (int q = 0; q < 6; ++q) fixed[k][q] = cv::v_setall_f32(w[k][2 + q]);  // features 2-7
+    for (int c = 0; c < 3; ++c) {
+      for (int q = 0; q < kVarying; ++q) k.a[c][q] = w[c][base[q]] + w[c][u_term[q] + 1] * v;
     }
-    for (int i = 0; i < padded; i += kLanes) {
-      const v_float32x4 u = cv::v_setall_f32((box.x + i + 0.5f) * inv_half_cols - 1.0f) + lane_u;
-      const v_float32x4 x = cv::v_load(&gx[i]), y = cv::v_load(&gy[i]);
-      const v_float32x4 depth = cv::v_load(&hh[i]);
-      const v_float32x4 rim_v = cv::v_load(&rim[i]);
-      const v_float32x4 bxv = cv::v_load(&bx[i]), byv = cv::v_load(&by[i]);
-      const v_float32x4 varying[kVarying] = {x,
-                                             y,
-                                             cv::v_max(bxv, zero),
-                                             cv::v_max(zero - bxv, zero),
-                                             cv::v_max(byv, zero),
-                                             cv::v_max(zero - byv, zero)};
-      const v_float32x4 constant[6] = {
-          x * x, x * y, y * y, depth, cv::v_max(rim_v, zero), cv::v_min(rim_v, zero)};
-      v_float32x4 channel[3];
-      if (cv::v_check_all((x == zero) & (y == zero) & (depth == zero))) {
-        // Outside the deformation (most of the box: the rim shadow's reach) only the rim terms
-        // are non-zero; the same sums in the same order, without the zero terms.
-        for (int k = 0; k < 3; ++k) {
-          v_float32x4 acc = cv::v_fma(fixed[k][5], constant[5], fixed[k][4] * constant[4]);
-          for (int q = 2; q < kVarying; ++q) {
-            acc = cv::v_fma(cv::v_fma(b[k][q], u, a[k][q]), varying[q], acc);
-          }
-          channel[k] = acc;
-        }
-        cv::v_store_interleave(&out[3 * i], channel[0], channel[1], channel[2]);
-        continue;
-      }
-      for (int k = 0; k < 3; ++k) {
-        v_float32x4 acc = zero;
-        for (int q = 0; q < 6; ++q) acc = cv::v_fma(fixed[k][q], constant[q], acc);
-        for (int q = 0; q < kVarying; ++q) {
-          acc = cv::v_fma(cv::v_fma(b[k][q], u, a[k][q]), varying[q], acc);
-        }
-        channel[k] = acc;
-      }
-      cv::v_store_interleave(&out[3 * i], channel[0], channel[1], channel[2]);
-    }
-    std::copy_n(out, 3 * width, diff.ptr<float>(j));
+    shadeRow(width, gx, gy, hh, rim, bx, by, u0, inv_half_cols, k, out_b, out_g, out_r);
+    cv::Vec3f* row = diff.ptr<cv::Vec3f>(j);
+    for (int i = 0; i < width; ++i) row[i] = cv::Vec3f(out_b[i], out_g[i], out_r[i]);
   }
 }
 
