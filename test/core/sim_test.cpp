@@ -383,7 +383,8 @@ TEST(ContactPatchTest, CentroidIsWhereTheBallPressesInGelMillimetres) {
   const SensorModel sensor = makeDigitSensorModel();
   ContactPatchMeter meter(sensor);
   const TexturedMesh ball = makeUvSphere(0.004, 64, 128);
-  for (const Eigen::Vector2d at : {Eigen::Vector2d(2.0e-3, -3.0e-3), Eigen::Vector2d(-4.5e-3, 5e-3)}) {
+  for (const Eigen::Vector2d& at :
+       {Eigen::Vector2d(2.0e-3, -3.0e-3), Eigen::Vector2d(-4.5e-3, 5e-3)}) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.translation() = Eigen::Vector3d(at.x(), at.y(), 0.004 - 0.6e-3);  // 0.6 mm deep
     const ContactPatch patch = meter.measure(ball, pose);

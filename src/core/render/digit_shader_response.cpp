@@ -66,11 +66,11 @@ void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, 
   full(cv::Rect(region.x - x0, region.y - y0, region.width, region.height)).copyTo(out);
 }
 
-// The per-pixel sums of the fused shading over one row (computeShadingDifference): plain loops
-// that the compiler vectorises. With GCC or Clang on x86-64 the loop is built twice, for AVX2
-// with FMA (8 pixels a step, fused multiply-adds) and for the x86-64 baseline (SSE2, 4 pixels),
-// and the CPU picks one when the library loads (a feature test, not a CPU model: new CPUs get
-// AVX2 too). The two agree to float rounding (an FMA rounds once).
+// The per-pixel sums of the fused shading over one row (computeShadingDifference), and the
+// differences they start from: plain loops that the compiler vectorises. With GCC or Clang on
+// x86-64 each is built twice, for AVX2 (8 pixels a step) and for the x86-64 baseline (SSE2, 4),
+// and a CPU feature test picks one when the library loads. Both do the same operations in the
+// same order per pixel, so they give the same floats (ISO C++ mode: no contraction into FMAs).
 constexpr int kVarying = 6;   // slope_x, slope_y, rim_right, rim_left, rim_down, rim_up
 constexpr int kConstant = 6;  // slope_xx, slope_xy, slope_yy, depth, rim_out, rim_in
 
@@ -153,7 +153,7 @@ void differencesBaseline(int first, int last, const float* h_row, const float* h
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
-__attribute__((target("avx2,fma"))) void differencesAvx2(
+__attribute__((target("avx2"))) void differencesAvx2(
     int first, int last, const float* h_row, const float* h_up, const float* h_down,
     const float* b_row, const float* b_up, const float* b_down, float half_inv_pixel,
     float dy_scale, float* gx, float* gy, float* hh, float* rim, float* bx, float* by) {
@@ -173,7 +173,7 @@ void shadeRowBaseline(int n, const float* gx, const float* gy, const float* hh, 
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
-__attribute__((target("avx2,fma"))) void shadeRowAvx2(int n, const float* gx, const float* gy,
+__attribute__((target("avx2"))) void shadeRowAvx2(int n, const float* gx, const float* gy,
                                                       const float* hh, const float* rim,
                                                       const float* bx, const float* by, float u0,
                                                       float du, const RowCoefficients& k,
@@ -185,7 +185,7 @@ __attribute__((target("avx2,fma"))) void shadeRowAvx2(int n, const float* gx, co
 bool hasAvx2() {
 #if defined(__GNUC__) && defined(__x86_64__)
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return __builtin_cpu_supports("avx2");
 #else
   return false;
 #endif
