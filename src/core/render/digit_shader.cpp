@@ -148,10 +148,15 @@ void DigitShader::shadeBox(const cv::Mat1f& h, const cv::Rect& box, cv::Mat3f& d
     shadeBoxAnalytic(h, box, diff);
     return;
   }
-  // NaN or infinity anywhere in the box would spread through the features.
-  if (!cv::checkRange(h(box))) {
-    throw Error("DigitShader: h_final_mm contains NaN or infinite values");
+  // NaN or infinity anywhere in the box would spread through the features. x - x is 0 exactly
+  // for a finite x and NaN otherwise; counted in integers, the loop vectorises (cv::checkRange
+  // took a tenth of the shading time).
+  int non_finite = 0;
+  for (int r = box.y; r < box.y + box.height; ++r) {
+    const float* row = h.ptr<float>(r) + box.x;
+    for (int i = 0; i < box.width; ++i) non_finite += !(row[i] - row[i] == 0.0f);
   }
+  if (non_finite > 0) throw Error("DigitShader: h_final_mm contains NaN or infinite values");
   computeShadingDifference(h, model_.mm_per_pixel, model_.shading, box, diff);
 }
 
