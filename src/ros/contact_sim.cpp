@@ -245,22 +245,25 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
   return true;
 }
 
-void ContactSim::onTimer(const ros::WallTimerEvent&) {
+void ContactSim::onTimer(const ros::WallTimerEvent& event) {
   std::lock_guard<std::mutex> lock(mutex_);
   // Physics follows the wall clock: a late timer (a loaded machine) catches up by stepping the
   // frames that are due, at most a few at a time; further behind, it warns and lets them go.
+  // Time is the tick's scheduled time, not when its callback ran: the stamps sit on the timer's
+  // grid, so a callback that runs late (a busy queue) delays the images, which the latency then
+  // shows, instead of shifting every later frame by a period.
   constexpr int kMaxCatchUp = 4;
-  const ros::WallTime now = ros::WallTime::now();
+  const ros::WallTime tick = event.current_expected;
+  tick_ = tick;
   if (wall_anchor_.isZero()) {  // first tick of an episode
-    wall_anchor_ = now;
+    wall_anchor_ = tick;
     anchor_frame_ = frame_;
   }
-  // A frame is due when the wall clock reaches its stamp, so a frame never leads the clock
-  // (stamp-to-image latencies stay meaningful); a tick up to kEarlyNs early still steps it, since
-  // timers jitter (floored exactly, an early tick would make every frame one tick late).
+  // A frame is due when its tick comes; kEarlyNs absorbs the rounding of the period to whole
+  // nanoseconds.
   constexpr std::int64_t kEarlyNs = 1'000'000;
   const std::int64_t due =
-      anchor_frame_ + 1 + ((now - wall_anchor_).toNSec() + kEarlyNs) / frame_period_ns_;
+      anchor_frame_ + 1 + ((tick - wall_anchor_).toNSec() + kEarlyNs) / frame_period_ns_;
   int stepped = 0;
   while (frame_ < due && stepped < kMaxCatchUp) {
     advanceFrame();
@@ -269,7 +272,7 @@ void ContactSim::onTimer(const ros::WallTimerEvent&) {
   if (frame_ < due) {
     ROS_WARN_THROTTLE(5.0, "contact_sim: %ld frames behind real time; skipping them",
                       static_cast<long>(due - frame_));
-    wall_anchor_ = now;
+    wall_anchor_ = tick;
     anchor_frame_ = frame_ - 1;
   }
 }
@@ -278,8 +281,9 @@ void ContactSim::advanceFrame() {
   sim_->step(ticks_per_frame_);
   ++frame_;
   if (anchor_to_wall_) {
-    time_base_ =
-        ros::Time::now() - (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
+    // The first frame's stamp is its tick's scheduled time (real time), or now.
+    const ros::Time first = tick_.isZero() ? ros::Time::now() : ros::Time(tick_.sec, tick_.nsec);
+    time_base_ = first - (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
     anchor_to_wall_ = false;
   }
   publishFrame();

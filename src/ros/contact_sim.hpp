@@ -83,6 +83,7 @@ class ContactSim {
   bool anchor_to_wall_ = false;
   ros::WallTime wall_anchor_;  ///< real time: when frame anchor_frame_ + 1 was due
   std::int64_t anchor_frame_ = 0;
+  ros::WallTime tick_;  ///< real time: the scheduled time of the timer tick being handled
   double beta_mm_ = 0.0;
   std::uint32_t episode_ = 0;
 
