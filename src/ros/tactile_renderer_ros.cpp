@@ -160,18 +160,26 @@ void TactileRendererRos::followFrameTexture(const SimFrame& frame) {
   if (frame.next_material.empty() || !mesh_->hasUvs()) return;
   const std::string next_key = frame.next_material + "/" + std::to_string(frame.next_variant);
   if (next_key == texture_key_) return;
-  TextureSource next;
-  try {
-    next = materialSource(frame.next_material, frame.next_variant);
-  } catch (const Error&) {
-    return;  // an unknown material: reported when a frame names it as its own
+  if (next_key != prefetch_key_) {  // resolved once per texture, not per frame (rospack)
+    prefetch_key_ = next_key;
+    prefetch_done_ = false;
+    try {
+      prefetch_source_ = materialSource(frame.next_material, frame.next_variant);
+    } catch (const Error&) {
+      prefetch_done_ = true;  // an unknown material: reported when a frame names it as its own
+      return;
+    }
   }
-  // The background works on a copy: the renderer keeps reading its mesh meanwhile.
+  if (prefetch_done_) return;
+  // The background works on a copy: the renderer keeps reading its mesh meanwhile. Another
+  // preparation under way: tried again with the next frame.
   std::shared_ptr<const TexturedMesh> mesh = mesh_;
-  textures_.prefetch(next_key, [next, mesh] {
-    TexturedMesh copy = *mesh;
-    return loadObjectTexture(next, copy);
-  });
+  prefetch_done_ = textures_.prefetch(next_key,
+                                      [source = prefetch_source_, mesh] {
+                                        TexturedMesh copy = *mesh;
+                                        return loadObjectTexture(source, copy);
+                                      }) ||
+                   textures_.contains(next_key);
 }
 
 bool TactileRendererRos::anyoneListens() const {
