@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 #include <opencv2/imgcodecs.hpp>
@@ -69,6 +70,17 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // The launch that starts the master may still be coming up: wait for it quietly (a node handle
+  // would retry with an error line per attempt), with a deadline.
+  const ros::WallTime master_deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (!ros::master::check()) {
+    if (ros::WallTime::now() > master_deadline) {
+      std::fprintf(stderr, "norm2tex_grasp_demo: no ROS master at %s within 30 s\n",
+                   ros::master::getURI().c_str());
+      return 1;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
   ros::NodeHandle nh;
   Latest latest;
   std::vector<ros::Subscriber> subs;
