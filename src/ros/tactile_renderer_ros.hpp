@@ -77,9 +77,9 @@ class TactileRendererRos {
   /// The latest textures (a dataset revisits few, and each is megabytes) and the next one,
   /// prepared in the background.
   ObjectTextureCache textures_{6};
-  std::string prefetch_key_;        ///< the texture frames name as the next one
-  TextureSource prefetch_source_;   ///< ... where it comes from
-  bool prefetch_done_ = true;       ///< ... and whether it is being or has been prepared
+  std::string prefetch_key_;       ///< the texture frames name as the next one
+  TextureSource prefetch_source_;  ///< ... where it comes from
+  bool prefetch_done_ = true;      ///< ... and whether it is being or has been prepared
   std::uint64_t rendered_ = 0, missed_ = 0;
   bool answered_any_ = false;
   std::uint64_t last_answered_frame_ = 0;

@@ -4,11 +4,11 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
-#include <future>
-#include <thread>
 #include <fstream>
+#include <future>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -170,7 +170,6 @@ TEST(ObjectTexture, MissingOrUnusableMeshTextureIsAWarningNamingIt) {
   test::expectError([&] { loadTextureFile(source, missing); }, {"nope.png"});
 }
 
-
 // --- ObjectTextureCache: the next texture prepared in the background --------------------------
 
 /// A texture whose description names the key, prepared in `delay_ms`; counts preparations.
@@ -238,9 +237,8 @@ TEST(ObjectTextureCache, BackgroundRunsWhileTheCallerGoesOn) {
 
 TEST(ObjectTextureCache, BackgroundErrorIsThrownByGetAndNotKept) {
   ObjectTextureCache cache(2);
-  ASSERT_TRUE(cache.prefetch("bad/0", []() -> ObjectTexture {
-    throw Error("material 'bad': no such file");
-  }));
+  ASSERT_TRUE(cache.prefetch(
+      "bad/0", []() -> ObjectTexture { throw Error("material 'bad': no such file"); }));
   try {
     cache.get("bad/0", [] { return ObjectTexture{}; });
     FAIL() << "expected the background's error";
@@ -286,8 +284,8 @@ TEST(ObjectTextureCache, PrefetchOfAKeptTextureStartsNothing) {
 
 TEST(ObjectTextureCache, RealMaterialPreparedInTheBackgroundEqualsOneMadeInPlace) {
   const std::string config = std::string(NORM2TEX_SOURCE_DIR) + "/config/materials/wood.yaml";
-  auto mesh = std::make_shared<const TexturedMesh>(
-      makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02));
+  auto mesh =
+      std::make_shared<const TexturedMesh>(makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02));
   const auto prepare = [&](int variant) {
     return [config, mesh, variant] {
       TextureSource source;
@@ -307,8 +305,7 @@ TEST(ObjectTextureCache, RealMaterialPreparedInTheBackgroundEqualsOneMadeInPlace
   source.variant = 5;
   const ObjectTexture in_place = loadObjectTexture(source, copy);
   ASSERT_TRUE(background.texture->atlas && in_place.atlas);
-  EXPECT_EQ(cv::norm(background.texture->atlas->heights(), in_place.atlas->heights(),
-                     cv::NORM_INF),
+  EXPECT_EQ(cv::norm(background.texture->atlas->heights(), in_place.atlas->heights(), cv::NORM_INF),
             0.0);
   EXPECT_EQ(background.texture->description, in_place.description);
 }

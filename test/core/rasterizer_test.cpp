@@ -106,7 +106,8 @@ TEST(ContactRasterizer, CentresExactlyOnEdgesAndCornersAreDrawnOnce) {
   // Wide triangles (~90 pixels a side): the closed-form row spans obey the same fill rule.
   for (const double yaw : {0.0, CV_PI / 2, CV_PI}) {
     expectEveryPixelExactlyOnce(makeGrid(6, 30.0, 0.0, model, true), pressedAndTurned(0.5, yaw),
-                                model, "wide triangles on pixel centres, yaw " + std::to_string(yaw));
+                                model,
+                                "wide triangles on pixel centres, yaw " + std::to_string(yaw));
   }
   expectEveryPixelExactlyOnce(makeGrid(6, 30.0, 0.0, model, true), flipped, model,
                               "wide triangles on pixel centres, flipped");

@@ -322,7 +322,8 @@ TEST(GelModel, ReducedResolutionLevelsMatchTheFullResolutionPyramid) {
     // Inside the core, beyond the reach of the final bending blur (which rounds a curved surface
     // by a few um), the gel is the input.
     cv::Mat1b core = indentation > model.gel.core_fraction * max_indentation;
-    const int reach = static_cast<int>(std::ceil(3.0 * model.gel.final_sigma_mm / model.mm_per_pixel)) + 1;
+    const int reach =
+        static_cast<int>(std::ceil(3.0 * model.gel.final_sigma_mm / model.mm_per_pixel)) + 1;
     cv::erode(core, core, cv::Mat(), cv::Point(-1, -1), reach);
     double core_error = 0.0;
     cv::minMaxLoc(cv::abs(gel - indentation), nullptr, &core_error, nullptr, nullptr, core);

@@ -100,8 +100,8 @@ NORM2TEX_ALWAYS_INLINE void shadeRowBody(int n, const float* __restrict gx,
                                      std::max(-bx[i], 0.0f),
                                      std::max(by[i], 0.0f),
                                      std::max(-by[i], 0.0f)};
-    const float constant[kConstant] = {x * x, x * y, y * y, hh[i], std::max(rim[i], 0.0f),
-                                       std::min(rim[i], 0.0f)};
+    const float constant[kConstant] = {
+        x * x, x * y, y * y, hh[i], std::max(rim[i], 0.0f), std::min(rim[i], 0.0f)};
     // Unrolled, so that the loop over pixels is the one vectorised.
     float acc[3] = {0.0f, 0.0f, 0.0f};
 #pragma GCC unroll 3
@@ -120,16 +120,12 @@ NORM2TEX_ALWAYS_INLINE void shadeRowBody(int n, const float* __restrict gx,
 /// Interior columns [first, last) of one row: central differences of H and of its blur B, the
 /// depth and B - H (no clamping, so the loop vectorises; the image's border columns are done
 /// apart).
-NORM2TEX_ALWAYS_INLINE void differencesBody(int first, int last, const float* __restrict h_row,
-                                            const float* __restrict h_up,
-                                            const float* __restrict h_down,
-                                            const float* __restrict b_row,
-                                            const float* __restrict b_up,
-                                            const float* __restrict b_down, float half_inv_pixel,
-                                            float dy_scale, float* __restrict gx,
-                                            float* __restrict gy, float* __restrict hh,
-                                            float* __restrict rim, float* __restrict bx,
-                                            float* __restrict by) {
+NORM2TEX_ALWAYS_INLINE void differencesBody(
+    int first, int last, const float* __restrict h_row, const float* __restrict h_up,
+    const float* __restrict h_down, const float* __restrict b_row, const float* __restrict b_up,
+    const float* __restrict b_down, float half_inv_pixel, float dy_scale, float* __restrict gx,
+    float* __restrict gy, float* __restrict hh, float* __restrict rim, float* __restrict bx,
+    float* __restrict by) {
   for (int i = first; i < last; ++i) {
     gx[i] = (h_row[i + 1] - h_row[i - 1]) * half_inv_pixel;
     gy[i] = (h_down[i] - h_up[i]) * dy_scale;
@@ -148,23 +144,25 @@ void differencesBaseline(int first, int last, const float* h_row, const float* h
                          const float* h_down, const float* b_row, const float* b_up,
                          const float* b_down, float half_inv_pixel, float dy_scale, float* gx,
                          float* gy, float* hh, float* rim, float* bx, float* by) {
-  differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel,
-                  dy_scale, gx, gy, hh, rim, bx, by);
+  differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel, dy_scale,
+                  gx, gy, hh, rim, bx, by);
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
-__attribute__((target("avx2"))) void differencesAvx2(
-    int first, int last, const float* h_row, const float* h_up, const float* h_down,
-    const float* b_row, const float* b_up, const float* b_down, float half_inv_pixel,
-    float dy_scale, float* gx, float* gy, float* hh, float* rim, float* bx, float* by) {
-  differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel,
-                  dy_scale, gx, gy, hh, rim, bx, by);
+__attribute__((target("avx2"))) void differencesAvx2(int first, int last, const float* h_row,
+                                                     const float* h_up, const float* h_down,
+                                                     const float* b_row, const float* b_up,
+                                                     const float* b_down, float half_inv_pixel,
+                                                     float dy_scale, float* gx, float* gy,
+                                                     float* hh, float* rim, float* bx, float* by) {
+  differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel, dy_scale,
+                  gx, gy, hh, rim, bx, by);
 }
 #endif
 
-using ShadeRow = void (*)(int, const float*, const float*, const float*, const float*,
-                          const float*, const float*, float, float, const RowCoefficients&,
-                          float*, float*, float*);
+using ShadeRow = void (*)(int, const float*, const float*, const float*, const float*, const float*,
+                          const float*, float, float, const RowCoefficients&, float*, float*,
+                          float*);
 
 void shadeRowBaseline(int n, const float* gx, const float* gy, const float* hh, const float* rim,
                       const float* bx, const float* by, float u0, float du,
@@ -174,10 +172,10 @@ void shadeRowBaseline(int n, const float* gx, const float* gy, const float* hh, 
 
 #if defined(__GNUC__) && defined(__x86_64__)
 __attribute__((target("avx2"))) void shadeRowAvx2(int n, const float* gx, const float* gy,
-                                                      const float* hh, const float* rim,
-                                                      const float* bx, const float* by, float u0,
-                                                      float du, const RowCoefficients& k,
-                                                      float* out_b, float* out_g, float* out_r) {
+                                                  const float* hh, const float* rim,
+                                                  const float* bx, const float* by, float u0,
+                                                  float du, const RowCoefficients& k, float* out_b,
+                                                  float* out_g, float* out_r) {
   shadeRowBody(n, gx, gy, hh, rim, bx, by, u0, du, k, out_b, out_g, out_r);
 }
 #endif

@@ -37,8 +37,7 @@ void ObjectTextureCache::keep(const std::string& key,
   while (kept_.size() > capacity_) kept_.pop_back();
 }
 
-ObjectTextureCache::Lookup ObjectTextureCache::get(const std::string& key,
-                                                   const Prepare& prepare) {
+ObjectTextureCache::Lookup ObjectTextureCache::get(const std::string& key, const Prepare& prepare) {
   const auto start = std::chrono::steady_clock::now();
   Lookup lookup;
   std::shared_future<std::shared_ptr<const ObjectTexture>> pending;

@@ -33,8 +33,7 @@ ContactPatch ContactPatchMeter::measure(const TexturedMesh& mesh,
   if (patch.pixels > 0) {
     const double pixel_m = model_.mm_per_pixel * 1e-3;
     patch.area_m2 = patch.pixels * pixel_m * pixel_m;
-    const cv::Point2d centroid_mm =
-        model_.pixelToGelMm(sum_r / patch.pixels, sum_c / patch.pixels);
+    const cv::Point2d centroid_mm = model_.pixelToGelMm(sum_r / patch.pixels, sum_c / patch.pixels);
     patch.centroid_m = Eigen::Vector2d(centroid_mm.x, centroid_mm.y) * 1e-3;
     patch.max_indentation_m = static_cast<double>(deepest_mm) * 1e-3;
   }
