@@ -82,9 +82,9 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
                 (ec ? ": " + ec.message() : std::string()));
   }
   std::filesystem::remove(probe, ec);
-  free_mb_ = freeMegabytes(params_.output_dir);
-  if (params_.min_free_mb > 0.0 && free_mb_ < params_.min_free_mb) {
-    throw Error("output directory '" + params_.output_dir + "' has " + text(free_mb_) +
+  const double free_mb = freeMegabytes(params_.output_dir);
+  if (params_.min_free_mb > 0.0 && free_mb < params_.min_free_mb) {
+    throw Error("output directory '" + params_.output_dir + "' has " + text(free_mb) +
                 " MB free, under ~min_free_mb = " + text(params_.min_free_mb) + " MB");
   }
   openNextBag();
@@ -202,9 +202,9 @@ bool DatasetRecorder::write(const std::string& topic,
   // while the index and the manifest still fit. Checked every 8 writes (~2 frames, ~1 MB).
   if (params_.min_free_mb > 0.0 && ++writes_since_space_check_ >= 8) {
     writes_since_space_check_ = 0;
-    free_mb_ = freeMegabytes(params_.output_dir);
-    if (free_mb_ < params_.min_free_mb && error_.empty()) {
-      error_ = "the disk of '" + params_.output_dir + "' is nearly full: " + text(free_mb_) +
+    const double free_mb = freeMegabytes(params_.output_dir);
+    if (free_mb < params_.min_free_mb && error_.empty()) {
+      error_ = "the disk of '" + params_.output_dir + "' is nearly full: " + text(free_mb) +
                " MB free, under ~min_free_mb = " + text(params_.min_free_mb) +
                " MB; recording stopped, the bag is closed with the frames written so far";
       ROS_ERROR("dataset_recorder: %s", error_.c_str());

@@ -104,9 +104,7 @@ class DatasetRecorder {
   std::string stop_reason_;
   std::uint64_t images_ = 0;
   bool done_ = false, closed_ = false;
-  /// Free space (MB) of the output file system at the last check, and writes since then.
-  double free_mb_ = 0.0;
-  int writes_since_space_check_ = 0;
+  int writes_since_space_check_ = 0;  ///< ~min_free_mb is checked every few writes
   std::string error_;
   ros::WallTime started_, last_progress_;
 

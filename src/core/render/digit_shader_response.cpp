@@ -180,16 +180,11 @@ __attribute__((target("avx2"))) void shadeRowAvx2(int n, const float* gx, const 
 }
 #endif
 
-bool hasAvx2() {
 #if defined(__GNUC__) && defined(__x86_64__)
+bool hasAvx2() {
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx2");
-#else
-  return false;
-#endif
 }
-
-#if defined(__GNUC__) && defined(__x86_64__)
 const ShadeRow shadeRow = hasAvx2() ? shadeRowAvx2 : shadeRowBaseline;
 const Differences differences = hasAvx2() ? differencesAvx2 : differencesBaseline;
 #else
