@@ -65,9 +65,32 @@ void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
   }
 }
 
+/// Bounding box of the pixels of `box` outside the core (empty when the core covers it).
+cv::Rect outsideCoreBox(const cv::Mat1b& core, const cv::Rect& box) {
+  int top = -1, bottom = -1, left = box.x + box.width, right = -1;
+  for (int r = box.y; r < box.y + box.height; ++r) {
+    const uchar* row = core.ptr<uchar>(r);
+    int first = box.x;
+    const int end = box.x + box.width;
+    while (first < end && row[first]) ++first;
+    if (first == end) continue;
+    int last = end - 1;
+    while (row[last]) --last;
+    if (top < 0) top = r;
+    bottom = r;
+    left = std::min(left, first);
+    right = std::max(right, last);
+  }
+  if (top < 0) return {};
+  return {left, top, right - left + 1, bottom - top + 1};
+}
+
 /// Gaussian blur of `field` restricted to the bounding box of its non-negligible values, grown
-/// by the kernel: the rest of the image is 0 and stays 0.
-void blurAroundDeformation(double sigma_px, cv::Mat1f& field) {
+/// by the kernel: the rest of the image is 0 and stays 0. With `core`, whose pixels the caller
+/// restores afterwards, only pixels outside it are written, so only their neighbourhood is
+/// blurred: a contact over most of the gel leaves a thin rim to compute. Same values as the
+/// whole box: the kernel never reaches the smaller region's inner edges from a written pixel.
+void blurAroundDeformation(double sigma_px, cv::Mat1f& field, const cv::Mat1b* core = nullptr) {
   const cv::Size kernel = kernelFor(sigma_px);
   cv::Rect box = deformationBox(field);
   if (box.empty()) return;
@@ -76,8 +99,22 @@ void blurAroundDeformation(double sigma_px, cv::Mat1f& field) {
   box.width += 2 * kernel.width;
   box.height += 2 * kernel.height;
   box &= cv::Rect(0, 0, field.cols, field.rows);
-  cv::Mat1f region = field(box);
-  cv::GaussianBlur(region.clone(), region, kernel, sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  if (core == nullptr) {
+    cv::Mat1f region = field(box);
+    cv::GaussianBlur(region.clone(), region, kernel, sigma_px, sigma_px, cv::BORDER_REPLICATE);
+    return;
+  }
+  const cv::Rect written = outsideCoreBox(*core, box);
+  if (written.empty()) return;
+  const int radius = kernel.width / 2;
+  const cv::Rect read =
+      cv::Rect(written.x - radius, written.y - radius, written.width + 2 * radius,
+               written.height + 2 * radius) &
+      box;
+  cv::Mat1f blurred;
+  cv::GaussianBlur(field(read), blurred, kernel, sigma_px, sigma_px,
+                   cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
+  blurred(written - read.tl()).copyTo(field(written));
 }
 
 }  // namespace
@@ -124,7 +161,7 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
       current_factor = factor;
     }
     const double level_mm_per_pixel = model_.mm_per_pixel * indentation_mm.cols / size.width;
-    blurAroundDeformation(sigma_mm / level_mm_per_pixel, current);
+    blurAroundDeformation(sigma_mm / level_mm_per_pixel, current, &level_core);
     restoreCore(level_in, level_core, current);
   }
   if (current.empty()) {
