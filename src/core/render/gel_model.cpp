@@ -107,10 +107,9 @@ void blurAroundDeformation(double sigma_px, cv::Mat1f& field, const cv::Mat1b* c
   const cv::Rect written = outsideCoreBox(*core, box);
   if (written.empty()) return;
   const int radius = kernel.width / 2;
-  const cv::Rect read =
-      cv::Rect(written.x - radius, written.y - radius, written.width + 2 * radius,
-               written.height + 2 * radius) &
-      box;
+  const cv::Rect read = cv::Rect(written.x - radius, written.y - radius, written.width + 2 * radius,
+                                 written.height + 2 * radius) &
+                        box;
   cv::Mat1f blurred;
   cv::GaussianBlur(field(read), blurred, kernel, sigma_px, sigma_px,
                    cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
