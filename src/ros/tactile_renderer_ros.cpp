@@ -208,19 +208,15 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
     if (params_.texture_from_frame) followFrameTexture(*frame);
     // The pose at exactly this stamp: wait (wall clock: simulated time may stand still) for TF,
     // never extrapolate or take a stale pose.
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.tf_timeout);
     std::string why;
-    while (!tf_buffer_.canTransform(params_.gel_frame, params_.object_frame, frame->header.stamp,
-                                    &why)) {
-      if (ros::WallTime::now() > deadline || !ros::ok()) {
-        std::ostringstream reason;
-        reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at "
-               << frame->header.stamp
-               << " not available within ~tf_timeout = " << params_.tf_timeout << " s (" << why
-               << ")";
-        throw Error(reason.str());
-      }
-      ros::WallDuration(0.0002).sleep();
+    if (!tf_waiter_.wait(params_.gel_frame, params_.object_frame, frame->header.stamp,
+                         params_.tf_timeout, &why)) {
+      if (!ros::ok()) throw Error("shutting down");
+      std::ostringstream reason;
+      reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at "
+             << frame->header.stamp << " not available within ~tf_timeout = " << params_.tf_timeout
+             << " s (" << why << ")";
+      throw Error(reason.str());
     }
     const Eigen::Isometry3d object_in_gel = ros_conversions::fromTransformMsg(
         tf_buffer_.lookupTransform(params_.gel_frame, params_.object_frame, frame->header.stamp)

@@ -16,6 +16,7 @@
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/object_texture_cache.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
+#include "transform_waiter.hpp"
 
 namespace norm2tex {
 
@@ -89,6 +90,7 @@ class TactileRendererRos {
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
+  TransformWaiter tf_waiter_{tf_buffer_};
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
   ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;
