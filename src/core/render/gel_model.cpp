@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -55,13 +56,21 @@ cv::Rect deformationBox(const cv::Mat1f& field) {
   return {left, top, right - left + 1, bottom - top + 1};
 }
 
+/// out = keep ? a : b for one row; both sides read, so it compiles to vector blends, not to a
+/// branch per pixel.
+void selectRow(const uchar* __restrict keep, const float* __restrict a, const float* __restrict b,
+               float* __restrict out, int count) {
+  for (int c = 0; c < count; ++c) {
+    const float from_a = a[c], from_b = b[c];
+    out[c] = keep[c] ? from_a : from_b;
+  }
+}
+
 /// out = in where core is set (the contact core restored).
 void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
   for (int r = 0; r < in.rows; ++r) {
-    const float* source = in.ptr<float>(r);
-    const uchar* mask = core.ptr<uchar>(r);
     float* target = out.ptr<float>(r);
-    for (int c = 0; c < in.cols; ++c) target[c] = mask[c] ? source[c] : target[c];
+    selectRow(core.ptr<uchar>(r), in.ptr<float>(r), target, target, in.cols);
   }
 }
 
@@ -69,13 +78,15 @@ void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
 cv::Rect outsideCoreBox(const cv::Mat1b& core, const cv::Rect& box) {
   int top = -1, bottom = -1, left = box.x + box.width, right = -1;
   for (int r = box.y; r < box.y + box.height; ++r) {
-    const uchar* row = core.ptr<uchar>(r);
-    int first = box.x;
-    const int end = box.x + box.width;
-    while (first < end && row[first]) ++first;
-    if (first == end) continue;
-    int last = end - 1;
-    while (row[last]) --last;
+    // A core row is mostly 255: memchr/memrchr find its first and last 0 a vector at a time.
+    const uchar* row = core.ptr<uchar>(r) + box.x;
+    const void* first_gap = std::memchr(row, 0, static_cast<std::size_t>(box.width));
+    if (first_gap == nullptr) continue;
+    const int first = box.x + static_cast<int>(static_cast<const uchar*>(first_gap) - row);
+    const int last =
+        box.x +
+        static_cast<int>(
+            static_cast<const uchar*>(memrchr(row, 0, static_cast<std::size_t>(box.width))) - row);
     if (top < 0) top = r;
     bottom = r;
     left = std::min(left, first);
@@ -86,10 +97,11 @@ cv::Rect outsideCoreBox(const cv::Mat1b& core, const cv::Rect& box) {
 }
 
 /// Gaussian blur of `field` restricted to the bounding box of its non-negligible values, grown
-/// by the kernel: the rest of the image is 0 and stays 0. With `core`, whose pixels the caller
-/// restores afterwards, only pixels outside it are written, so only their neighbourhood is
-/// blurred: a contact over most of the gel leaves a thin rim to compute. Same values as the
-/// whole box: the kernel never reaches the smaller region's inner edges from a written pixel.
+/// by the kernel: the rest of the image is 0 and stays 0. With `core`, pixels inside it keep
+/// their values (the caller's field holds the core's own there) and only the neighbourhood of
+/// the others is blurred: a contact over most of the gel leaves a thin rim to compute. Same
+/// values as blurring the whole box and restoring the core: the kernel never reaches the smaller
+/// region's inner edges from a written pixel.
 void blurAroundDeformation(double sigma_px, cv::Mat1f& field, const cv::Mat1b* core = nullptr) {
   const cv::Size kernel = kernelFor(sigma_px);
   cv::Rect box = deformationBox(field);
@@ -113,7 +125,11 @@ void blurAroundDeformation(double sigma_px, cv::Mat1f& field, const cv::Mat1b* c
   cv::Mat1f blurred;
   cv::GaussianBlur(field(read), blurred, kernel, sigma_px, sigma_px,
                    cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
-  blurred(written - read.tl()).copyTo(field(written));
+  for (int r = written.y; r < written.y + written.height; ++r) {
+    float* target = field.ptr<float>(r) + written.x;
+    selectRow(core->ptr<uchar>(r) + written.x, target,
+              blurred.ptr<float>(r - read.y) + (written.x - read.x), target, written.width);
+  }
 }
 
 }  // namespace
@@ -147,9 +163,11 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
         level_core = core;
       } else {
         cv::resize(indentation_mm, level_in, size, 0, 0, cv::INTER_AREA);
-        cv::Mat1f core_fraction;
-        cv::resize(cv::Mat1f(core / 255), core_fraction, size, 0, 0, cv::INTER_AREA);
-        level_core = core_fraction > 0.5f;
+        // Core where more than half of the pixels are: an area average of 0/255 over n pixels
+        // is 255 k / n, rounded; k = n/2 gives at most 128.
+        cv::Mat1b core_share;
+        cv::resize(core, core_share, size, 0, 0, cv::INTER_AREA);
+        level_core = core_share > 128;
       }
       if (current.empty()) {
         current = level_in.clone();
@@ -160,8 +178,9 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
       current_factor = factor;
     }
     const double level_mm_per_pixel = model_.mm_per_pixel * indentation_mm.cols / size.width;
+    // current holds level_in on the core (restored at every change of resolution), and the
+    // blur keeps it there.
     blurAroundDeformation(sigma_mm / level_mm_per_pixel, current, &level_core);
-    restoreCore(level_in, level_core, current);
   }
   if (current.empty()) {
     indentation_mm.copyTo(out);
