@@ -88,6 +88,9 @@ class ContactSim {
   std::uint32_t episode_ = 0;
 
   std::mutex mutex_;  // nodelet callbacks may run on several threads
+  /// ~reset and ~step's queue: declared before the servers on it, which remove themselves from
+  /// it when destroyed (a destroyed queue's mutex made the manager abort at shutdown).
+  ros::CallbackQueue service_queue_;
   ros::NodeHandle nh_, private_nh_;
   ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, frame_pub_, contact_pub_[2];
   ros::Publisher markers_pub_, object_marker_pub_;
@@ -95,7 +98,6 @@ class ContactSim {
   ros::ServiceServer reset_srv_, step_srv_;
   ros::WallTimer timer_;
 
-  ros::CallbackQueue service_queue_;
   /// Synchronous mode with ~renderers: waits for every renderer's answer to each frame.
   std::unique_ptr<LockStep> lock_step_;
 
