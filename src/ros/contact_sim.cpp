@@ -16,6 +16,7 @@
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "params.hpp"
@@ -72,6 +73,7 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
 
 ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readContactSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
+  keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   const MaterialConfig material = loadMaterialConfig(params_.material_config);
   beta_mm_ = params_.beta >= 0.0 ? params_.beta : material.beta_mm;
   const SensorModel sensor = loadSensorModel(params_.sensor);

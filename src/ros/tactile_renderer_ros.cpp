@@ -9,6 +9,7 @@
 
 #include "conversions.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
@@ -83,6 +84,7 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
       tf_buffer_(ros::Duration(30.0)),
       tf_listener_(tf_buffer_, nh),
       it_(nh) {
+  keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   SensorModel model = loadSensorModel(params_.sensor);
   if (!params_.background.empty()) model.background_image = params_.background;
   renderer_ = std::make_unique<TactileRenderer>(model);
