@@ -68,6 +68,8 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   pnh.param("beta", p.beta, -1.0);
   pnh.param<std::string>("scenario", p.scenario, p.scenario);
   readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
+  pnh.param("window", p.window, p.window);
+  if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
   return p;
 }
 
@@ -117,7 +119,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   lock_step_ = std::make_unique<LockStep>(
       private_nh_,
       params_.synchronous ? params_.renderers : std::vector<std::string>(),
-      params_.render_timeout, params_.ready_timeout, "contact_sim");
+      params_.render_timeout, params_.ready_timeout, "contact_sim", params_.window);
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
   // ~reset and ~step block while the renderers work: they get a thread of their own, so that in
   // a nodelet manager they never hold a worker thread a renderer's queue is pinned to.
@@ -216,6 +218,7 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
   try {
     response.info = startEpisode(request.seed, request.height_offset);
     publishFrame();
+    lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
     ROS_WARN("contact_sim: ~reset failed: %s", e.what());
     return false;
@@ -237,6 +240,8 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
       ++frame_;
       response.missing_images += publishFrame();
     }
+    // Returns only once every frame of the step is answered: its images are all out.
+    response.missing_images += lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
     ROS_ERROR("contact_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
     return false;

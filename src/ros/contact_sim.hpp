@@ -42,6 +42,10 @@ struct ContactSimParams {
   double render_timeout = 5.0;  ///< ~render_timeout [s of wall time] for each FrameRendered
   /// ~ready_timeout [s of wall time] for the renderers to start (texture bakes included)
   double ready_timeout = 60.0;
+  /// ~window: frames of one ~step in flight at once: the physics of the next frame runs while
+  /// the renderers draw this one. Every ~step and ~reset still returns only once all of its
+  /// frames are answered (1 = strict lock-step within a step too).
+  int window = 2;
 };
 
 /// Reads and validates the private parameters; throws Error naming the parameter and its valid
