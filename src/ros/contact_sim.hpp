@@ -1,20 +1,22 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
+#include "lock_step.hpp"
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
-#include "lock_step.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 
@@ -58,12 +60,18 @@ class ContactSim {
  public:
   /// Throws Error (bad parameter, unreadable scene/mesh/material) before advertising anything.
   ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~ContactSim();
+  ContactSim(const ContactSim&) = delete;
+  ContactSim& operator=(const ContactSim&) = delete;
 
  private:
   void onCommand(const GripperCommand::ConstPtr& msg);
   bool onReset(Reset::Request& request, Reset::Response& response);
   bool onStep(Step::Request& request, Step::Response& response);
-  void onTimer(const ros::WallTimerEvent& event);
+  /// Real time: sleeps to each frame period's tick (absolute wall-clock time) and handles it on
+  /// its own thread.
+  void runClock();
+  void onTick(const ros::WallTime& tick);
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
   bool applyCommand(const GripperCommand& command);
@@ -100,13 +108,15 @@ class ContactSim {
   ros::Publisher markers_pub_, object_marker_pub_;
   ros::Subscriber command_sub_;
   ros::ServiceServer reset_srv_, step_srv_;
-  ros::WallTimer timer_;
 
   /// Synchronous mode with ~renderers: waits for every renderer's answer to each frame.
   std::unique_ptr<LockStep> lock_step_;
 
   // Last: destroyed (stopped and joined) first, while everything its callbacks use exists.
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
+  /// Real time: the frame clock (a thread woken at each tick; joined by the destructor).
+  std::atomic<bool> stop_clock_{false};
+  std::thread clock_thread_;
 };
 
 }  // namespace norm2tex
