@@ -7,6 +7,7 @@
 #include <string>
 
 #include <image_transport/image_transport.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
@@ -102,7 +103,11 @@ class TactileRendererRos {
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
   ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;
+  /// The frames' queue, served by frame_spinner_; declared before the subscription on it.
+  ros::CallbackQueue frame_queue_;
   ros::Subscriber frame_sub_;
+  // Last: stopped (and joined) first, while everything onFrame uses exists.
+  std::unique_ptr<ros::AsyncSpinner> frame_spinner_;
 };
 
 }  // namespace norm2tex
