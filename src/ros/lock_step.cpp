@@ -39,7 +39,8 @@ LockStep::LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> r
   ros::NodeHandle nh(private_nh);
   nh.setCallbackQueue(&queue_);
   // One topic for every renderer's answers: answers name their sensor.
-  sub_ = nh.subscribe("rendered", 1000, &LockStep::onRendered, this);
+  sub_ = nh.subscribe("rendered", 1000, &LockStep::onRendered, this,
+                      ros::TransportHints().tcpNoDelay());
 }
 
 LockStep::~LockStep() = default;

@@ -56,9 +56,11 @@ int main(int argc, char** argv) {
   // Room for every image of a run: a benchmark that drops images at its own queue would
   // measure itself.
   const int queue = 2 * frames + 200;
-  ros::Subscriber left = nh.subscribe<sensor_msgs::Image>("digit_left/image_raw", queue, on_image);
+  const ros::TransportHints hints = ros::TransportHints().tcpNoDelay();
+  ros::Subscriber left =
+      nh.subscribe<sensor_msgs::Image>("digit_left/image_raw", queue, on_image, {}, hints);
   ros::Subscriber right =
-      nh.subscribe<sensor_msgs::Image>("digit_right/image_raw", queue, on_image);
+      nh.subscribe<sensor_msgs::Image>("digit_right/image_raw", queue, on_image, {}, hints);
   if (!waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60)) {
     std::fprintf(stderr, "norm2tex_ros_bench: no image publishers within 60 s\n");
     return 1;

@@ -82,7 +82,8 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
     : params_(readTactileRendererParams(private_nh)),
       nh_(nh),
       tf_buffer_(ros::Duration(30.0)),
-      tf_listener_(tf_buffer_, nh),
+      // No Nagle delay on the small TF and frame messages between separate nodes.
+      tf_listener_(tf_buffer_, nh, true, ros::TransportHints().tcpNoDelay()),
       it_(nh) {
   keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   SensorModel model = loadSensorModel(params_.sensor);
@@ -135,7 +136,8 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   // worker), ~0.3 ms at the median here. One thread keeps them in order.
   ros::NodeHandle frame_nh(nh_);
   frame_nh.setCallbackQueue(&frame_queue_);
-  frame_sub_ = frame_nh.subscribe(params_.frame_topic, 100, &TactileRendererRos::onFrame, this);
+  frame_sub_ = frame_nh.subscribe(params_.frame_topic, 100, &TactileRendererRos::onFrame, this,
+                                  ros::TransportHints().tcpNoDelay());
   frame_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &frame_queue_);
   frame_spinner_->start();
   // Latched: contact_sim, whenever it subscribes, learns that this renderer is ready.
