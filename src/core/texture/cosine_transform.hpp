@@ -16,8 +16,9 @@ class CosineTransform {
   /// Spectrum of `x` (rows x cols, both even), computed in place: `x` is overwritten. The
   /// spectrum is laid out *transposed*: spectrum(u, v) is the coefficient of
   /// cos(pi u (c + 1/2) / cols) cos(pi v (r + 1/2) / rows). Returns `x` itself for a square
-  /// `x` (transposed in place), else internal memory valid until the next call. In place
-  /// because every full-size buffer is fresh memory, and first touch is most of a large bake.
+  /// `x` of 512 and more (transposed in place), else internal memory valid until the next
+  /// call. In place because every full-size buffer is fresh memory, and first touch is most
+  /// of a large bake.
   cv::Mat1f& forward(cv::Mat1f& x);
   /// Inverse of forward(): `spectrum` must be the matrix forward() returned (it is
   /// overwritten); writes rows x cols into `x` (forward's input, or any rows x cols matrix).
