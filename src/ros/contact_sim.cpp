@@ -1,5 +1,7 @@
 #include "contact_sim.hpp"
 
+#include <time.h>
+
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -16,6 +18,7 @@
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "params.hpp"
@@ -67,11 +70,14 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   pnh.param("beta", p.beta, -1.0);
   pnh.param<std::string>("scenario", p.scenario, p.scenario);
   readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
+  pnh.param("window", p.window, p.window);
+  if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
   return p;
 }
 
 ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readContactSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
+  keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   const MaterialConfig material = loadMaterialConfig(params_.material_config);
   beta_mm_ = params_.beta >= 0.0 ? params_.beta : material.beta_mm;
   const SensorModel sensor = loadSensorModel(params_.sensor);
@@ -115,7 +121,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   lock_step_ = std::make_unique<LockStep>(
       private_nh_,
       params_.synchronous ? params_.renderers : std::vector<std::string>(),
-      params_.render_timeout, params_.ready_timeout, "contact_sim");
+      params_.render_timeout, params_.ready_timeout, "contact_sim", params_.window);
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
   // ~reset and ~step block while the renderers work: they get a thread of their own, so that in
   // a nodelet manager they never hold a worker thread a renderer's queue is pinned to.
@@ -128,8 +134,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   service_spinner_->start();
   if (!params_.synchronous) {
-    timer_ =
-        nh_.createWallTimer(ros::WallDuration(frame_period_ns_ * 1e-9), &ContactSim::onTimer, this);
+    clock_thread_ = std::thread(&ContactSim::runClock, this);
   }
   object_marker_pub_.publish(ros_conversions::objectMarker(sim_->object().mesh, ros::Time(0)));
   // Synchronous renderers get their first frame with the first step (or reset); publishing one
@@ -214,6 +219,7 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
   try {
     response.info = startEpisode(request.seed, request.height_offset);
     publishFrame();
+    lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
     ROS_WARN("contact_sim: ~reset failed: %s", e.what());
     return false;
@@ -235,6 +241,8 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
       ++frame_;
       response.missing_images += publishFrame();
     }
+    // Returns only once every frame of the step is answered: its images are all out.
+    response.missing_images += lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
     ROS_ERROR("contact_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
     return false;
@@ -245,15 +253,43 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
   return true;
 }
 
-void ContactSim::onTimer(const ros::WallTimerEvent& event) {
+ContactSim::~ContactSim() {
+  stop_clock_ = true;
+  if (clock_thread_.joinable()) clock_thread_.join();
+}
+
+void ContactSim::runClock() {
+  // Ticks on a fixed grid of absolute times, slept to with clock_nanosleep: one wake-up per
+  // frame, straight into the physics. (A ros::WallTimer went through ROS's timer thread and a
+  // callback queue: two thread hand-overs, ~0.25 ms late at the median here.) ros::WallTime is
+  // CLOCK_REALTIME, so the ticks are wall-clock stamps.
+  const std::int64_t period = frame_period_ns_;
+  std::int64_t next = ros::WallTime::now().toNSec() + period;
+  while (!stop_clock_ && ros::ok()) {
+    timespec when;
+    when.tv_sec = static_cast<time_t>(next / 1'000'000'000);
+    when.tv_nsec = static_cast<long>(next % 1'000'000'000);
+    if (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &when, nullptr) != 0) continue;  // EINTR
+    if (stop_clock_) break;
+    ros::WallTime tick;
+    tick.fromNSec(static_cast<std::uint64_t>(next));
+    onTick(tick);
+    next += period;
+    // Far behind (a stalled machine): onTick has let the missed frames go; so does the grid.
+    const std::int64_t now = ros::WallTime::now().toNSec();
+    if (next < now - 4 * period) next += ((now - next) / period) * period;
+  }
+}
+
+void ContactSim::onTick(const ros::WallTime& tick_time) {
   std::lock_guard<std::mutex> lock(mutex_);
-  // Physics follows the wall clock: a late timer (a loaded machine) catches up by stepping the
+  // Physics follows the wall clock: a late tick (a loaded machine) catches up by stepping the
   // frames that are due, at most a few at a time; further behind, it warns and lets them go.
-  // Time is the tick's scheduled time, not when its callback ran: the stamps sit on the timer's
-  // grid, so a callback that runs late (a busy queue) delays the images, which the latency then
-  // shows, instead of shifting every later frame by a period.
+  // Time is the tick's scheduled time, not when it ran: the stamps sit on the clock's grid, so
+  // a tick handled late delays the images, which the latency then shows, instead of shifting
+  // every later frame by a period.
   constexpr int kMaxCatchUp = 4;
-  const ros::WallTime tick = event.current_expected;
+  const ros::WallTime tick = tick_time;
   tick_ = tick;
   if (wall_anchor_.isZero()) {  // first tick of an episode
     wall_anchor_ = tick;

@@ -1,20 +1,22 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 
+#include "lock_step.hpp"
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
-#include "lock_step.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 
@@ -42,6 +44,10 @@ struct ContactSimParams {
   double render_timeout = 5.0;  ///< ~render_timeout [s of wall time] for each FrameRendered
   /// ~ready_timeout [s of wall time] for the renderers to start (texture bakes included)
   double ready_timeout = 60.0;
+  /// ~window: frames of one ~step in flight at once: the physics of the next frame runs while
+  /// the renderers draw this one. Every ~step and ~reset still returns only once all of its
+  /// frames are answered (1 = strict lock-step within a step too).
+  int window = 2;
 };
 
 /// Reads and validates the private parameters; throws Error naming the parameter and its valid
@@ -54,12 +60,18 @@ class ContactSim {
  public:
   /// Throws Error (bad parameter, unreadable scene/mesh/material) before advertising anything.
   ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~ContactSim();
+  ContactSim(const ContactSim&) = delete;
+  ContactSim& operator=(const ContactSim&) = delete;
 
  private:
   void onCommand(const GripperCommand::ConstPtr& msg);
   bool onReset(Reset::Request& request, Reset::Response& response);
   bool onStep(Step::Request& request, Step::Response& response);
-  void onTimer(const ros::WallTimerEvent& event);
+  /// Real time: sleeps to each frame period's tick (absolute wall-clock time) and handles it on
+  /// its own thread.
+  void runClock();
+  void onTick(const ros::WallTime& tick);
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
   bool applyCommand(const GripperCommand& command);
@@ -88,19 +100,23 @@ class ContactSim {
   std::uint32_t episode_ = 0;
 
   std::mutex mutex_;  // nodelet callbacks may run on several threads
+  /// ~reset and ~step's queue: declared before the servers on it, which remove themselves from
+  /// it when destroyed (a destroyed queue's mutex made the manager abort at shutdown).
+  ros::CallbackQueue service_queue_;
   ros::NodeHandle nh_, private_nh_;
   ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, frame_pub_, contact_pub_[2];
   ros::Publisher markers_pub_, object_marker_pub_;
   ros::Subscriber command_sub_;
   ros::ServiceServer reset_srv_, step_srv_;
-  ros::WallTimer timer_;
 
-  ros::CallbackQueue service_queue_;
   /// Synchronous mode with ~renderers: waits for every renderer's answer to each frame.
   std::unique_ptr<LockStep> lock_step_;
 
   // Last: destroyed (stopped and joined) first, while everything its callbacks use exists.
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
+  /// Real time: the frame clock (a thread woken at each tick; joined by the destructor).
+  std::atomic<bool> stop_clock_{false};
+  std::thread clock_thread_;
 };
 
 }  // namespace norm2tex

@@ -12,6 +12,7 @@
 #include "norm2tex/TactileContact.h"
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "params.hpp"
 
 namespace norm2tex {
@@ -73,6 +74,7 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
 
 DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readDatasetRecorderParams(private_nh)), nh_(nh) {
+  keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   // An unwritable directory fails now, naming it, not at the first frame.
   std::error_code ec;
   std::filesystem::create_directories(params_.output_dir, ec);

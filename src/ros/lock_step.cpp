@@ -40,12 +40,23 @@ LockStep::LockStep(const ros::NodeHandle& private_nh, std::vector<std::string> r
   nh.setCallbackQueue(&queue_);
   // One topic for every renderer's answers: answers name their sensor.
   sub_ = nh.subscribe("rendered", 1000, &LockStep::onRendered, this);
-  spinner_ = std::make_unique<ros::AsyncSpinner>(1, &queue_);
-  spinner_->start();
 }
 
-LockStep::~LockStep() {
-  if (spinner_) spinner_->stop();
+LockStep::~LockStep() = default;
+
+bool LockStep::serveAnswersUntil(std::unique_lock<std::mutex>& lock,
+                                 const std::function<bool()>& done, double seconds) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!done()) {
+    const double left =
+        std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
+    if (left <= 0.0) return false;
+    lock.unlock();
+    // Wakes as soon as an answer is queued and handles it on this thread.
+    queue_.callAvailable(ros::WallDuration(std::min(left, 0.05)));
+    lock.lock();
+  }
+  return true;
 }
 
 void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
@@ -60,9 +71,8 @@ void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
       ++answers_;
       if (!msg->published) {
         ++missing_images_;
-        ROS_WARN("%s: %s published no image for frame %lu: %s", owner_.c_str(),
-                 msg->sensor.c_str(), static_cast<unsigned long>(msg->frame),
-                 msg->reason.c_str());
+        ROS_WARN("%s: %s published no image for frame %lu: %s", owner_.c_str(), msg->sensor.c_str(),
+                 static_cast<unsigned long>(msg->frame), msg->reason.c_str());
       }
       // Frames leave in order once every listed renderer has answered them.
       while (!in_flight_.empty() &&
@@ -71,7 +81,6 @@ void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
       }
     }
   }
-  cv_.notify_all();
 }
 
 std::string LockStep::notReady() const {
@@ -86,22 +95,19 @@ void LockStep::waitUntilReady() {
   if (!waits()) return;
   std::unique_lock<std::mutex> lock(mutex_);
   auto ready = [&] { return notReady().empty(); };
-  if (cv_.wait_for(lock, std::chrono::duration<double>(ready_timeout_), ready)) return;
+  if (serveAnswersUntil(lock, ready, ready_timeout_)) return;
   throw Error(owner_ + ": renderers" + notReady() + " not ready within ~ready_timeout = " +
-              ros_params::text(ready_timeout_) +
-              " s (are the tactile_renderer nodes running?)");
+              ros_params::text(ready_timeout_) + " s (are the tactile_renderer nodes running?)");
 }
 
 std::uint32_t LockStep::waitForAnswers(std::unique_lock<std::mutex>& lock,
                                        const ros::Publisher& pub, std::size_t limit) {
-  auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_);
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_);
   std::uint64_t seen = answers_;
   while (in_flight_.size() > limit) {
-    if (cv_.wait_for(lock, std::chrono::milliseconds(200),
-                     [&] { return in_flight_.size() <= limit; })) {
+    if (serveAnswersUntil(
+            lock, [&] { return in_flight_.size() <= limit; }, 0.2))
       break;
-    }
     if (!ros::ok()) throw Error(owner_ + ": shutting down");
     if (answers_ != seen) {  // progress: the timeout counts from the latest answer
       seen = answers_;
@@ -112,9 +118,8 @@ std::uint32_t LockStep::waitForAnswers(std::unique_lock<std::mutex>& lock,
       for (const std::string& r : renderers_) {
         if (!oldest.answered.count(r)) missing += " " + r;
       }
-      throw Error("no answer from" + missing + " to frame " +
-                  std::to_string(oldest.frame.frame) + " within ~render_timeout = " +
-                  ros_params::text(timeout_) + " s");
+      throw Error("no answer from" + missing + " to frame " + std::to_string(oldest.frame.frame) +
+                  " within ~render_timeout = " + ros_params::text(timeout_) + " s");
     }
     for (const auto& [number, f] : in_flight_) pub.publish(f.frame);  // offer them again
   }

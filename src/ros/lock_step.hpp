@@ -1,7 +1,7 @@
 #pragma once
 
-#include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -28,9 +28,10 @@ void readLockStepParams(const ros::NodeHandle& private_nh, std::vector<std::stri
 /// downstream is skipped or raced. Up to `window` frames may be in flight (published, not yet
 /// answered by everyone): 1 is strict lock-step (a policy reads the images of a frame before the
 /// next), more lets the source, the renderers and a recorder work on consecutive frames at once
-/// (a dataset: still nothing lost, drain() waits for the rest). Answers arrive on a queue and
-/// thread of their own: the waiting caller may hold the thread a nodelet manager would deliver
-/// them on.
+/// (a dataset: still nothing lost, drain() waits for the rest). Answers arrive on a queue of
+/// their own, which the waiting caller serves itself: it may hold the thread a nodelet manager
+/// would deliver them on, and no thread hand-over stands between an answer and the caller.
+/// Not for concurrent callers (the frame sources call it from one thread at a time).
 class LockStep {
  public:
   /// `renderers`: names whose answers every frame waits for (empty: publish without waiting);
@@ -63,6 +64,10 @@ class LockStep {
   /// a message; renderers answer a repeated frame without rendering it twice).
   std::uint32_t waitForAnswers(std::unique_lock<std::mutex>& lock, const ros::Publisher& pub,
                                std::size_t limit);
+  /// Handles answers on the calling thread (mutex_ held through `lock`, released while waiting)
+  /// until done() or `seconds` pass; returns done().
+  bool serveAnswersUntil(std::unique_lock<std::mutex>& lock, const std::function<bool()>& done,
+                         double seconds);
   /// " name name": renderers that have not said they are ready. Call with mutex_ held.
   std::string notReady() const;
 
@@ -73,12 +78,10 @@ class LockStep {
   ros::CallbackQueue queue_;
   ros::Subscriber sub_;
   std::mutex mutex_;
-  std::condition_variable cv_;
   std::set<std::string> ready_;
   std::map<std::uint64_t, InFlight> in_flight_;  ///< by frame number
   std::uint32_t missing_images_ = 0;             ///< reported since the last publish/drain
   std::uint64_t answers_ = 0;                    ///< answers to frames in flight, ever
-  std::unique_ptr<ros::AsyncSpinner> spinner_;   // last: stopped first
 };
 
 }  // namespace norm2tex

@@ -11,6 +11,7 @@
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
@@ -103,6 +104,7 @@ ProbeSimParams readProbeSimParams(const ros::NodeHandle& pnh) {
 
 ProbeSim::ProbeSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readProbeSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
+  keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   if (!ros::Time::isSimTime()) {
     throw Error(
         "probe_sim needs /use_sim_time = true (it is a synchronous frame source); set it before "

@@ -96,10 +96,12 @@ class ProbeSim {
 
   std::mutex mutex_;
   std::atomic<bool> stop_{false};
+  /// ~step's queue: declared before the server on it, which removes itself from it when
+  /// destroyed.
+  ros::CallbackQueue service_queue_;
   ros::NodeHandle nh_, private_nh_;
   ros::Publisher tf_pub_, clock_pub_, episode_pub_, frame_pub_, contact_pub_, marker_pub_;
   ros::ServiceServer step_srv_;
-  ros::CallbackQueue service_queue_;
   std::unique_ptr<LockStep> lock_step_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
   std::thread runner_;

@@ -4,10 +4,12 @@
 #include <filesystem>
 #include <sstream>
 
+#include <opencv2/core/utility.hpp>
 #include <ros/package.h>
 
 #include "conversions.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
@@ -59,6 +61,14 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   if (!(p.tf_timeout > 0.0 && p.tf_timeout <= 60.0)) {
     badParameter("tf_timeout", std::to_string(p.tf_timeout), "(0, 60] s");
   }
+  pnh.param("queue_size", p.queue_size, p.queue_size);
+  if (p.queue_size < 1 || p.queue_size > 10000) {
+    badParameter("queue_size", std::to_string(p.queue_size), "[1, 10000] messages");
+  }
+  pnh.param("opencv_threads", p.opencv_threads, p.opencv_threads);
+  if (p.opencv_threads < -1 || p.opencv_threads == 0 || p.opencv_threads > 64) {
+    badParameter("opencv_threads", std::to_string(p.opencv_threads), "1 to 64, or -1");
+  }
   pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
   pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
   pnh.param("texture_from_frame", p.texture_from_frame, p.texture_from_frame);
@@ -74,6 +84,7 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
       tf_buffer_(ros::Duration(30.0)),
       tf_listener_(tf_buffer_, nh),
       it_(nh) {
+  keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   SensorModel model = loadSensorModel(params_.sensor);
   if (!params_.background.empty()) model.background_image = params_.background;
   renderer_ = std::make_unique<TactileRenderer>(model);
@@ -95,15 +106,22 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   source.atlas = params_.atlas;
   ROS_INFO("%s: preparing the texture of %s ...", params_.sensor_name.c_str(), mesh_spec.c_str());
   useTexture(source, params_.material + "/" + std::to_string(params_.variant));
+  // Each sensor renders on its own callback thread, the sensors in parallel. OpenCV's pool on
+  // top adds a hand-over to other threads per resize, which cost more than they saved on these
+  // 320 x 240 images and competed with the other sensor (the start-up bake above still had it).
+  if (params_.opencv_threads > 0) cv::setNumThreads(params_.opencv_threads);
   ROS_INFO("%s: rendering %s in %s on %s%s", params_.sensor_name.c_str(),
            params_.object_frame.c_str(), params_.gel_frame.c_str(), params_.frame_topic.c_str(),
            params_.texture_from_frame ? ", texture as each frame names it" : "");
 
   const std::string& ns = params_.sensor_name;
-  image_pub_ = it_.advertise(ns + "/image_raw", 10);
-  info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>(ns + "/camera_info", 10);
-  depth_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/depth", 10);
-  if (params_.publish_mask) mask_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/contact_mask", 10);
+  const std::uint32_t queue = static_cast<std::uint32_t>(params_.queue_size);
+  image_pub_ = it_.advertise(ns + "/image_raw", queue);
+  info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>(ns + "/camera_info", queue);
+  depth_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/depth", queue);
+  if (params_.publish_mask) {
+    mask_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/contact_mask", queue);
+  }
   // The no-contact frame (without noise), latched: what background-subtracted datasets subtract.
   background_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/background", 1, /*latch=*/true);
   std_msgs::Header background_header;
@@ -208,19 +226,15 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
     if (params_.texture_from_frame) followFrameTexture(*frame);
     // The pose at exactly this stamp: wait (wall clock: simulated time may stand still) for TF,
     // never extrapolate or take a stale pose.
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.tf_timeout);
     std::string why;
-    while (!tf_buffer_.canTransform(params_.gel_frame, params_.object_frame, frame->header.stamp,
-                                    &why)) {
-      if (ros::WallTime::now() > deadline || !ros::ok()) {
-        std::ostringstream reason;
-        reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at "
-               << frame->header.stamp
-               << " not available within ~tf_timeout = " << params_.tf_timeout << " s (" << why
-               << ")";
-        throw Error(reason.str());
-      }
-      ros::WallDuration(0.0002).sleep();
+    if (!tf_waiter_.wait(params_.gel_frame, params_.object_frame, frame->header.stamp,
+                         params_.tf_timeout, &why)) {
+      if (!ros::ok()) throw Error("shutting down");
+      std::ostringstream reason;
+      reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at "
+             << frame->header.stamp << " not available within ~tf_timeout = " << params_.tf_timeout
+             << " s (" << why << ")";
+      throw Error(reason.str());
     }
     const Eigen::Isometry3d object_in_gel = ros_conversions::fromTransformMsg(
         tf_buffer_.lookupTransform(params_.gel_frame, params_.object_frame, frame->header.stamp)

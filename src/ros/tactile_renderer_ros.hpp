@@ -16,6 +16,7 @@
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/object_texture_cache.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
+#include "transform_waiter.hpp"
 
 namespace norm2tex {
 
@@ -40,6 +41,14 @@ struct TactileRendererParams {
   int noise_seed = 0;         ///< ~noise_seed; < 0: no noise
   bool publish_mask = false;  ///< ~publish_mask: also /<sensor>/contact_mask (mono8)
   double tf_timeout = 1.0;    ///< ~tf_timeout [s of wall time] for the pose at a frame's stamp
+  /// ~opencv_threads: OpenCV's thread pool size once the first texture is ready (process-wide,
+  /// so shared by the nodelets of a manager); 1 renders on the frame callback's thread alone,
+  /// -1 leaves OpenCV's default.
+  int opencv_threads = 1;
+  /// ~queue_size: outgoing messages kept per subscriber of each topic. A subscriber further
+  /// behind than this loses the oldest (ROS's publisher queue): 100 frames is 1.7 s at 60 Hz, or
+  /// a ~step of many frames outrunning a subscriber by 100 images (23 MB of images per topic).
+  int queue_size = 100;
   std::string frame_topic = "contact_sim/frame";      ///< ~frame_topic: SimFrame source
   std::string answer_topic = "contact_sim/rendered";  ///< ~answer_topic: FrameRendered sink
   /// ~texture_from_frame: render each frame with the material and variant its SimFrame names
@@ -89,6 +98,7 @@ class TactileRendererRos {
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
+  TransformWaiter tf_waiter_{tf_buffer_};
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
   ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;

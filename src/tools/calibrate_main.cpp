@@ -1,6 +1,5 @@
 // norm2tex_calibrate: fits a sensor yaml to your own DIGIT from no-contact frames and a few
 // ball presses (see norm2tex/calibrate/sensor_calibration.hpp for the method).
-#include <malloc.h>
 
 #include <chrono>
 #include <cstdio>
@@ -20,6 +19,7 @@
 #include "norm2tex/calibrate/calibration_report.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/common/image_io.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 
@@ -168,11 +168,9 @@ std::vector<std::optional<norm2tex::PressCircle>> loadLabels(
 }
 
 int run(int argc, char** argv) {
-  // The fit renders thousands of presses through frame-sized temporaries. glibc hands blocks
-  // over 128 KB straight back to the kernel, and on these VMs every fresh 4 KB page costs
-  // ~13 us to fault in again; keeping freed memory in the heap makes calibration ~3x faster.
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+  // The fit renders thousands of presses through frame-sized temporaries: reused, not faulted
+  // in afresh each time (~3x faster calibration).
+  norm2tex::keepFreedMemoryForReuse();
   std::vector<std::string> expanded = expandLists(argc, argv);
   std::vector<char*> pointers;
   for (std::string& argument : expanded) pointers.push_back(argument.data());

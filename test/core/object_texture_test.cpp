@@ -1,8 +1,11 @@
 // Where an object's texture comes from: a mesh's own normal texture, embedded in a GLB or a
 // file next to it, and what happens when it cannot be used.
+#include <malloc.h>
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <future>
@@ -15,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/object_texture_cache.hpp"
@@ -308,6 +312,26 @@ TEST(ObjectTextureCache, RealMaterialPreparedInTheBackgroundEqualsOneMadeInPlace
   EXPECT_EQ(cv::norm(background.texture->atlas->heights(), in_place.atlas->heights(), cv::NORM_INF),
             0.0);
   EXPECT_EQ(background.texture->description, in_place.description);
+}
+
+}  // namespace
+}  // namespace norm2tex
+
+namespace norm2tex {
+namespace {
+
+TEST(MemoryReuse, FreedTextureSizedBlocksStayInTheHeapForTheNextOne) {
+  // A 1024^2 float texture is 4 MB: by default glibc maps such a block fresh and unmaps it on
+  // free, so the next texture faults every page in again.
+  ASSERT_TRUE(keepFreedMemoryForReuse());
+  const std::size_t size = 4u << 20;
+  const std::size_t mapped_before = mallinfo2().hblkhd;
+  void* block = std::malloc(size);
+  ASSERT_NE(block, nullptr);
+  std::memset(block, 1, size);
+  EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "the block was mapped, not taken from the heap";
+  std::free(block);
+  EXPECT_GE(mallinfo2().fordblks, size) << "the freed block went back to the kernel";
 }
 
 }  // namespace

@@ -136,6 +136,7 @@ TEST(BadInput, StartUpErrorsExitNonZeroNamingTheCause) {
       {"_mode:=turbo", "real_time, synchronous"},
       {"_physics_rate:=5.0", "~physics_rate"},
       {"_sensor:=/nonexistent/digit.yaml", "/nonexistent/digit.yaml"},
+      {"_window:=0", "~window"},
   };
   for (const Case& c : cases) {
     std::string output;

@@ -419,6 +419,8 @@ TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
       {"_material:='' _normal_map:=/nonexistent/normal.png", "/nonexistent/normal.png"},
       {"_background:=/nonexistent/bg.png", "/nonexistent/bg.png"},
       {"_tf_timeout:=-1", "~tf_timeout"},
+      {"_queue_size:=0", "~queue_size"},
+      {"_opencv_threads:=0", "~opencv_threads"},
   };
   for (const Case& c : cases) {
     std::string output;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -55,19 +56,53 @@ cv::Rect deformationBox(const cv::Mat1f& field) {
   return {left, top, right - left + 1, bottom - top + 1};
 }
 
-/// out = in where core is set (the contact core restored).
-void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
-  for (int r = 0; r < in.rows; ++r) {
-    const float* source = in.ptr<float>(r);
-    const uchar* mask = core.ptr<uchar>(r);
-    float* target = out.ptr<float>(r);
-    for (int c = 0; c < in.cols; ++c) target[c] = mask[c] ? source[c] : target[c];
+/// out = keep ? a : b for one row; both sides read, so it compiles to vector blends, not to a
+/// branch per pixel.
+void selectRow(const uchar* __restrict keep, const float* __restrict a, const float* __restrict b,
+               float* __restrict out, int count) {
+  for (int c = 0; c < count; ++c) {
+    const float from_a = a[c], from_b = b[c];
+    out[c] = keep[c] ? from_a : from_b;
   }
 }
 
+/// out = in where core is set (the contact core restored).
+void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
+  for (int r = 0; r < in.rows; ++r) {
+    float* target = out.ptr<float>(r);
+    selectRow(core.ptr<uchar>(r), in.ptr<float>(r), target, target, in.cols);
+  }
+}
+
+/// Bounding box of the pixels of `box` outside the core (empty when the core covers it).
+cv::Rect outsideCoreBox(const cv::Mat1b& core, const cv::Rect& box) {
+  int top = -1, bottom = -1, left = box.x + box.width, right = -1;
+  for (int r = box.y; r < box.y + box.height; ++r) {
+    // A core row is mostly 255: memchr/memrchr find its first and last 0 a vector at a time.
+    const uchar* row = core.ptr<uchar>(r) + box.x;
+    const void* first_gap = std::memchr(row, 0, static_cast<std::size_t>(box.width));
+    if (first_gap == nullptr) continue;
+    const int first = box.x + static_cast<int>(static_cast<const uchar*>(first_gap) - row);
+    const int last =
+        box.x +
+        static_cast<int>(
+            static_cast<const uchar*>(memrchr(row, 0, static_cast<std::size_t>(box.width))) - row);
+    if (top < 0) top = r;
+    bottom = r;
+    left = std::min(left, first);
+    right = std::max(right, last);
+  }
+  if (top < 0) return {};
+  return {left, top, right - left + 1, bottom - top + 1};
+}
+
 /// Gaussian blur of `field` restricted to the bounding box of its non-negligible values, grown
-/// by the kernel: the rest of the image is 0 and stays 0.
-void blurAroundDeformation(double sigma_px, cv::Mat1f& field) {
+/// by the kernel: the rest of the image is 0 and stays 0. With `core`, pixels inside it keep
+/// their values (the caller's field holds the core's own there) and only the neighbourhood of
+/// the others is blurred: a contact over most of the gel leaves a thin rim to compute. Same
+/// values as blurring the whole box and restoring the core: the kernel never reaches the smaller
+/// region's inner edges from a written pixel.
+void blurAroundDeformation(double sigma_px, cv::Mat1f& field, const cv::Mat1b* core = nullptr) {
   const cv::Size kernel = kernelFor(sigma_px);
   cv::Rect box = deformationBox(field);
   if (box.empty()) return;
@@ -76,8 +111,25 @@ void blurAroundDeformation(double sigma_px, cv::Mat1f& field) {
   box.width += 2 * kernel.width;
   box.height += 2 * kernel.height;
   box &= cv::Rect(0, 0, field.cols, field.rows);
-  cv::Mat1f region = field(box);
-  cv::GaussianBlur(region.clone(), region, kernel, sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  if (core == nullptr) {
+    cv::Mat1f region = field(box);
+    cv::GaussianBlur(region.clone(), region, kernel, sigma_px, sigma_px, cv::BORDER_REPLICATE);
+    return;
+  }
+  const cv::Rect written = outsideCoreBox(*core, box);
+  if (written.empty()) return;
+  const int radius = kernel.width / 2;
+  const cv::Rect read = cv::Rect(written.x - radius, written.y - radius, written.width + 2 * radius,
+                                 written.height + 2 * radius) &
+                        box;
+  cv::Mat1f blurred;
+  cv::GaussianBlur(field(read), blurred, kernel, sigma_px, sigma_px,
+                   cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
+  for (int r = written.y; r < written.y + written.height; ++r) {
+    float* target = field.ptr<float>(r) + written.x;
+    selectRow(core->ptr<uchar>(r) + written.x, target,
+              blurred.ptr<float>(r - read.y) + (written.x - read.x), target, written.width);
+  }
 }
 
 }  // namespace
@@ -111,9 +163,11 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
         level_core = core;
       } else {
         cv::resize(indentation_mm, level_in, size, 0, 0, cv::INTER_AREA);
-        cv::Mat1f core_fraction;
-        cv::resize(cv::Mat1f(core / 255), core_fraction, size, 0, 0, cv::INTER_AREA);
-        level_core = core_fraction > 0.5f;
+        // Core where more than half of the pixels are: an area average of 0/255 over n pixels
+        // is 255 k / n, rounded; k = n/2 gives at most 128.
+        cv::Mat1b core_share;
+        cv::resize(core, core_share, size, 0, 0, cv::INTER_AREA);
+        level_core = core_share > 128;
       }
       if (current.empty()) {
         current = level_in.clone();
@@ -124,8 +178,9 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
       current_factor = factor;
     }
     const double level_mm_per_pixel = model_.mm_per_pixel * indentation_mm.cols / size.width;
-    blurAroundDeformation(sigma_mm / level_mm_per_pixel, current);
-    restoreCore(level_in, level_core, current);
+    // current holds level_in on the core (restored at every change of resolution), and the
+    // blur keeps it there.
+    blurAroundDeformation(sigma_mm / level_mm_per_pixel, current, &level_core);
   }
   if (current.empty()) {
     indentation_mm.copyTo(out);

@@ -79,6 +79,8 @@ void validate(const GripperSimConfig& c) {
                    "[1, 100]");
   requireParameter(p.solver_iterations >= 1 && p.solver_iterations <= 10000,
                    "physics.solver_iterations", p.solver_iterations, "[1, 10000]");
+  requireParameter(p.solver_tolerance_m_s >= 0.0 && p.solver_tolerance_m_s <= 1e-2,
+                   "physics.solver_tolerance_m_s", p.solver_tolerance_m_s, "[0, 0.01] m/s");
   requireParameter(p.gravity_m_s2 >= 0.0 && p.gravity_m_s2 <= 100.0, "physics.gravity_m_s2",
                    p.gravity_m_s2, "[0, 100] m/s^2");
   requireParameter(p.gel_damping >= 0.0 && p.gel_damping <= 1e4, "physics.gel_damping",
@@ -143,11 +145,12 @@ GripperSimConfig loadGripperSimConfig(const std::string& yaml_path) {
 
     const YAML::Node p = root["physics"];
     requireKnownKeys(p, "physics",
-                     {"rate_hz", "substeps", "solver_iterations", "gravity_m_s2", "gel_damping",
-                      "friction_erp"});
+                     {"rate_hz", "substeps", "solver_iterations", "solver_tolerance_m_s",
+                      "gravity_m_s2", "gel_damping", "friction_erp"});
     read(p, "rate_hz", c.physics.rate_hz);
     read(p, "substeps", c.physics.substeps);
     read(p, "solver_iterations", c.physics.solver_iterations);
+    read(p, "solver_tolerance_m_s", c.physics.solver_tolerance_m_s);
     read(p, "gravity_m_s2", c.physics.gravity_m_s2);
     read(p, "gel_damping", c.physics.gel_damping);
     read(p, "friction_erp", c.physics.friction_erp);

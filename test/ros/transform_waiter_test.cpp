@@ -1,0 +1,69 @@
+// TransformWaiter: a pose at an exact stamp, waited for without polling (no master needed).
+#include <thread>
+
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <tf2/buffer_core.h>
+
+#include "transform_waiter.hpp"
+
+namespace norm2tex {
+namespace {
+
+geometry_msgs::TransformStamped objectInGel(double stamp_s, double x) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time(stamp_s);
+  t.header.frame_id = "gel";
+  t.child_frame_id = "object";
+  t.transform.translation.x = x;
+  t.transform.rotation.w = 1.0;
+  return t;
+}
+
+TEST(TransformWaiterTest, ReturnsAtOnceWhenTheStampIsBetweenReceivedPoses) {
+  tf2::BufferCore buffer;
+  TransformWaiter waiter(buffer);
+  buffer.setTransform(objectInGel(1.0, 0.0), "test");
+  buffer.setTransform(objectInGel(3.0, 2.0), "test");
+  EXPECT_TRUE(waiter.wait("gel", "object", ros::Time(2.0), 0.0));
+  EXPECT_DOUBLE_EQ(buffer.lookupTransform("gel", "object", ros::Time(2.0)).transform.translation.x,
+                   1.0);
+}
+
+TEST(TransformWaiterTest, WakesWhenThePoseArrivesFromAnotherThread) {
+  tf2::BufferCore buffer;
+  TransformWaiter waiter(buffer);
+  buffer.setTransform(objectInGel(1.0, 0.0), "test");
+  ASSERT_FALSE(buffer.canTransform("gel", "object", ros::Time(2.0)));
+  for (int frame = 2; frame <= 4; ++frame) {  // several waits on one waiter
+    std::thread publisher([&buffer, frame] {
+      // Arrives while the waiter waits (a late TF message); the wait below has 30 s for it.
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      buffer.setTransform(objectInGel(frame, frame), "test");
+    });
+    EXPECT_TRUE(waiter.wait("gel", "object", ros::Time(frame), 30.0)) << "frame " << frame;
+    publisher.join();
+  }
+}
+
+TEST(TransformWaiterTest, NeverExtrapolatesAndGivesTheReasonAfterTheTimeout) {
+  tf2::BufferCore buffer;
+  TransformWaiter waiter(buffer);
+  buffer.setTransform(objectInGel(1.0, 0.0), "test");
+  buffer.setTransform(objectInGel(2.0, 1.0), "test");
+  std::string why;
+  EXPECT_FALSE(waiter.wait("gel", "object", ros::Time(2.5), 0.05, &why));  // future: not yet
+  EXPECT_NE(why.find("extrapolation"), std::string::npos) << why;
+  why.clear();
+  EXPECT_FALSE(waiter.wait("gel", "object", ros::Time(0.5), 0.05, &why));  // before the data
+  EXPECT_NE(why.find("past"), std::string::npos) << why;
+  why.clear();
+  EXPECT_FALSE(waiter.wait("gel", "nowhere", ros::Time(1.5), 0.05, &why));
+  EXPECT_NE(why.find("nowhere"), std::string::npos) << why;
+  // A pose that arrives after a wait gave up does not confuse the next wait.
+  buffer.setTransform(objectInGel(3.0, 2.0), "test");
+  EXPECT_TRUE(waiter.wait("gel", "object", ros::Time(2.5), 0.0));
+}
+
+}  // namespace
+}  // namespace norm2tex
