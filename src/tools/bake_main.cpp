@@ -166,15 +166,14 @@ int run(int argc, char** argv) {
     atlas = norm2tex::bakeHeightAtlas(normal_map, options, shown, &report);
   }
   const double bake_seconds = secondsSince(bake_start);
-
+  const double long_wavelength_fraction =
+      quiet ? 0.0 : norm2tex::longWavelengthVarianceFraction(atlas.heights(), atlas.valid(), 64.0);
   if (extension == ".png") {
     norm2tex::writeImage(output, previewImage(atlas, options));
   } else {
     // Invalid texels are NaN in the TIFF: --atlas reads them back as invalid, so the file
     // keeps the atlas's validity mask (0 would be a valid height of 0).
-    cv::Mat1f heights = atlas.heights().clone();
-    heights.setTo(std::numeric_limits<float>::quiet_NaN(), atlas.valid() == 0);
-    norm2tex::writeImage(output, heights);
+    norm2tex::writeImage(output, std::move(atlas).takeHeightsInvalidAsNaN());
   }
   if (!quiet) {
     std::printf("%s: %dx%d texels, %d valid, %d UV island%s\n", args.positional()[0].c_str(),
@@ -185,9 +184,8 @@ int run(int argc, char** argv) {
     } else {
       std::printf("no relief high-pass; ");
     }
-    std::printf(
-        "%.0f %% of H_global's variance at wavelengths above 64 texels\n",
-        100.0 * norm2tex::longWavelengthVarianceFraction(atlas.heights(), atlas.valid(), 64.0));
+    std::printf("%.0f %% of H_global's variance at wavelengths above 64 texels\n",
+                100.0 * long_wavelength_fraction);
     if (args.has("--mesh")) {
       std::printf(
           "mesh: %d UV charts, %.4g mm per texel; %d seam edges, step across seams %.1f%% -> "

@@ -1,7 +1,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -60,6 +62,71 @@ TEST_F(AtlasCacheTest, MeshBakesAreCachedUnderTheMeshToo) {
   EXPECT_NE(cache.key(normal_map_path_, "", options, &mesh),
             cache.key(normal_map_path_, "", options));
   EXPECT_FALSE(cache.loadOrBake(normal_map_path_, "", options, {}, &wider).was_cached);
+}
+
+TEST_F(AtlasCacheTest, EmbeddedTextureIsCachedWithTheBakesIslands) {
+  // A GLB's embedded normal texture ("*0") arrives as the encoded file's bytes. Two charts of a
+  // 20 x 15 mm plate, its halves, meet at a seam (x = 10 mm) and lie apart in the texture; the
+  // map has no alpha, so only the mesh makes them two islands.
+  const TexturedMesh mesh({{0, 0, 0},
+                           {0.01f, 0, 0},
+                           {0.01f, 0.015f, 0},
+                           {0, 0.015f, 0},
+                           {0.01f, 0, 0},
+                           {0.02f, 0, 0},
+                           {0.02f, 0.015f, 0},
+                           {0.01f, 0.015f, 0}},
+                          {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}},
+                          {{0.05f, 0.1f},
+                           {0.45f, 0.1f},
+                           {0.45f, 0.9f},
+                           {0.05f, 0.9f},
+                           {0.55f, 0.1f},
+                           {0.95f, 0.1f},
+                           {0.95f, 0.9f},
+                           {0.55f, 0.9f}});
+  std::ifstream file(normal_map_path_, std::ios::binary);
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)),
+                                         std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 100u);
+  const std::string what = "the mesh's normal texture '*0'";
+  const AtlasCache cache(dir_.path("cache"));
+  BakeOptions options;
+  options.physical_scale = true;  // as for a mesh's own texture: heights in mm
+
+  const AtlasCache::Result first = cache.loadOrBake(bytes, what, options, {}, &mesh);
+  EXPECT_FALSE(first.was_cached);
+  EXPECT_TRUE(first.store_error.empty()) << first.store_error;
+  EXPECT_EQ(first.mesh_report.chart_count, 2);
+  EXPECT_EQ(first.atlas.islandCount(), 2) << "the mesh's charts, not the mask's one island";
+  const HeightAtlas direct = bakeHeightAtlasForMesh(
+      NormalMap::fromImage(cv::imread(normal_map_path_, cv::IMREAD_UNCHANGED)), mesh, options);
+  EXPECT_EQ(cv::norm(first.atlas.heights(), direct.heights(), cv::NORM_INF), 0.0);
+
+  const AtlasCache::Result second = cache.loadOrBake(bytes, what, options, {}, &mesh);
+  EXPECT_TRUE(second.was_cached);
+  EXPECT_EQ(cv::norm(first.atlas.heights(), second.atlas.heights(), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(first.atlas.valid() != second.atlas.valid()), 0);
+  EXPECT_EQ(cv::countNonZero(first.atlas.islandLabels() != second.atlas.islandLabels()), 0);
+  EXPECT_EQ(second.atlas.islandCount(), 2);
+
+  // The entry names the embedded texture; the same bytes in a file share it.
+  const std::string key = cache.key(bytes, options, &mesh);
+  EXPECT_NE(readFile(dir_.path("cache/" + key + ".yaml")).find(what), std::string::npos);
+  EXPECT_EQ(key, cache.key(normal_map_path_, "", options, &mesh));
+  // Other bytes, another mesh, other options: other entries.
+  std::vector<unsigned char> changed = bytes;
+  changed[changed.size() / 2] ^= 1;
+  EXPECT_NE(key, cache.key(changed, options, &mesh));
+  EXPECT_NE(key, cache.key(bytes, options));
+  BakeOptions other = options;
+  other.relief_cutoff_mm = 1.0;
+  EXPECT_NE(key, cache.key(bytes, other, &mesh));
+
+  // Truncated bytes: refused, naming the texture (never decoded half grey, never cached).
+  const std::vector<unsigned char> truncated(bytes.begin(), bytes.begin() + bytes.size() / 2);
+  test::expectError([&] { cache.loadOrBake(truncated, what, options, {}, &mesh); }, {"*0"});
+  EXPECT_FALSE(cache.load(cache.key(truncated, options, &mesh)).has_value());
 }
 
 TEST_F(AtlasCacheTest, SecondLoadComesFromTheCacheBitForBit) {

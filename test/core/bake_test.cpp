@@ -232,6 +232,34 @@ TEST(Bake, FineReliefSurvivesLargeDrift) {
   testing::Test::RecordProperty("relief_kept_ring", std::to_string(ring_kept));
 }
 
+TEST(Bake, OneSolveOfTheBlendedSlopesIsTheBlendOfTwoSolves) {
+  // Integration is linear, so integrating (1 - alpha) g_fine + alpha g_coarse once equals
+  // (1 - alpha) H_fine + alpha H_coarse. Heights compared unscaled by percentiles (physical
+  // scale, range -1,1: only multiplied by mm per texel).
+  const cv::Size size(128, 128);
+  for (const bool irregular : {false, true}) {
+    const cv::Mat1b mask = irregular ? makeIslandMask(size, 2, 4) : cv::Mat1b(size, 255);
+    const NormalMap map = test::quantisedNormalMap(mixedSurface(size), mask, CV_16U);
+    const auto heights = [&](double alpha) {
+      BakeOptions options;
+      options.alpha = alpha;
+      options.mm_per_texel = 0.05;
+      options.physical_scale = true;
+      options.integration.tolerance = 1e-6;  // the iteration's error below the 1e-5 compared
+      options.integration.max_iterations = 2000;
+      return cv::Mat1f(bakeHeightAtlas(map, options).heights());
+    };
+    const cv::Mat1f fine = heights(0.0), coarse = heights(1.0), blended = heights(0.2);
+    const cv::Mat1f two_solves = 0.8f * fine + 0.2f * coarse;
+    double low, high;
+    cv::minMaxLoc(blended, &low, &high, nullptr, nullptr, map.valid());
+    const double difference = cv::norm(blended, two_solves, cv::NORM_INF, map.valid());
+    EXPECT_LT(difference / (high - low), 1e-5) << (irregular ? "irregular islands" : "one island");
+    EXPECT_GT(cv::norm(fine, coarse, cv::NORM_INF, map.valid()) / (high - low), 1e-2)
+        << "the passes differ, so the blend is tested";
+  }
+}
+
 TEST(Bake, PhysicalScaleGivesMillimetresAndReportsTheAmplitude) {
   // Slopes are dh/dx: a wave of amplitude 2 texels at 0.05 mm per texel is 0.1 mm high.
   const cv::Size size(128, 128);

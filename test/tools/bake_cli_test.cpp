@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -80,8 +81,18 @@ TEST_F(BakeCli, BadInputExitsNonZeroWithOneLineReason) {
   std::string bytes(1000, '\0');
   whole.read(&bytes[0], 1000);
   std::ofstream(path("truncated.jpg"), std::ios::binary) << bytes;
-  for (const std::string input : {"missing.png", "empty.png", "corrupt.png", "gray.png",
-                                  "transparent.png", "truncated.jpg"}) {
+  // A PNG and a TIFF cut in half: refused too, not decoded with their missing rows.
+  for (const std::string name : {"whole.png", "whole.tif"}) {
+    cv::imwrite(path(name), noise);
+    std::ifstream file(path(name), std::ios::binary);
+    const std::string whole_file((std::istreambuf_iterator<char>(file)),
+                                 std::istreambuf_iterator<char>());
+    std::ofstream(path("truncated" + name.substr(5)), std::ios::binary)
+        << whole_file.substr(0, whole_file.size() / 2);
+  }
+  for (const std::string input :
+       {"missing.png", "empty.png", "corrupt.png", "gray.png", "transparent.png", "truncated.jpg",
+        "truncated.png", "truncated.tif"}) {
     const CliRun run = bake(path(input) + " -o " + path("out.tiff"));
     EXPECT_EQ(run.exit_code, 1) << input << ": " << run.output;
     EXPECT_EQ(run.output.rfind("norm2tex_bake: error: ", 0), 0u) << run.output;

@@ -1,6 +1,7 @@
 // Runs the real norm2tex_render executable: outputs, the sheet, exit codes and messages.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 
@@ -116,6 +117,34 @@ TEST_F(RenderCli, AtlasNaNTexelsAreInvalidAndInfiniteOnesAnError) {
   EXPECT_EQ(bad.exit_code, 1) << bad.output;
   EXPECT_NE(bad.output.find("infinite"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(path("bad.png")));
+}
+
+TEST_F(RenderCli, BetaZeroBakesNothing) {
+  // A texture at beta 0 is the textureless render: nothing is baked (no cache entry), the image
+  // is the one without a texture bit for bit, and the normal map is not even read.
+  const CliRun zero = render(std::string(kBall) + " --normal-map " + path("ridges.png") +
+                             " --beta 0 --no-noise -o " + path("zero.png"));
+  ASSERT_EQ(zero.exit_code, 0) << zero.output;
+  EXPECT_NE(zero.output.find("textureless"), std::string::npos) << zero.output;
+  EXPECT_EQ(zero.output.find("texture:"), std::string::npos) << "nothing loaded: " << zero.output;
+  EXPECT_TRUE(!fs::exists(path("cache")) || fs::is_empty(path("cache"))) << "nothing baked";
+  const CliRun plain = render(std::string(kBall) + " --no-noise -o " + path("plain.png"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const cv::Mat zero_image = cv::imread(path("zero.png")),
+                plain_image = cv::imread(path("plain.png"));
+  ASSERT_FALSE(zero_image.empty());
+  EXPECT_EQ(cv::norm(zero_image, plain_image, cv::NORM_INF), 0.0);
+  std::ofstream(path("broken.png")) << "not a png";
+  EXPECT_EQ(render(std::string(kBall) + " --normal-map " + path("broken.png") + " --beta 0 -o " +
+                   path("broken_zero.png"))
+                .exit_code,
+            0);
+  // The same texture at beta 0.2 is baked (one cache entry) and shows.
+  const CliRun textured = render(std::string(kBall) + " --normal-map " + path("ridges.png") +
+                                 " --beta 0.2 --no-noise -o " + path("textured.png"));
+  ASSERT_EQ(textured.exit_code, 0) << textured.output;
+  EXPECT_FALSE(fs::is_empty(path("cache")));
+  EXPECT_GT(cv::norm(cv::imread(path("textured.png")), plain_image, cv::NORM_L1), 0.0);
 }
 
 TEST_F(RenderCli, BadInputIsAOneLineErrorOrUsage) {

@@ -90,6 +90,11 @@ class HeightAtlas {
   UvWrap wrap() const { return wrap_; }
   void setWrap(UvWrap wrap) { wrap_ = wrap; }
 
+  /// The heights with NaN at the invalid texels (H_global's float TIFF form, whose NaN
+  /// `norm2tex_render --atlas` reads back as invalid), taken out of the atlas without a copy
+  /// (a copy would be 64 MB of fresh memory at 4096^2); the atlas is empty afterwards.
+  cv::Mat1f takeHeightsInvalidAsNaN() &&;
+
  private:
   /// `index` in [-1, size]: one texel off either edge at most.
   int wrapIndex(int index, int size) const {

@@ -7,7 +7,7 @@ namespace norm2tex {
 namespace detail {
 namespace {
 
-using Bytes = std::vector<unsigned char>;
+using Bytes = ByteView;
 
 bool startsWith(const Bytes& bytes, const char* magic, size_t length) {
   return bytes.size() >= length && std::memcmp(bytes.data(), magic, length) == 0;
@@ -105,7 +105,7 @@ std::string checkTiff(const Bytes& bytes) {
 
 }  // namespace
 
-std::string incompleteImageReason(const Bytes& bytes) {
+std::string incompleteImageReason(ByteView bytes) {
   if (startsWith(bytes, "\x89PNG\r\n\x1a\n", 8)) return checkPng(bytes);
   if (startsWith(bytes, "\xFF\xD8", 2)) return checkJpeg(bytes);
   if (startsWith(bytes, "II", 2) || startsWith(bytes, "MM", 2)) return checkTiff(bytes);

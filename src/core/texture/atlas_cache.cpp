@@ -58,11 +58,14 @@ std::string AtlasCache::defaultDirectory() {
   return (fs::path(home && *home ? home : "/tmp") / ".cache" / "norm2tex").string();
 }
 
-std::string AtlasCache::key(const std::string& normal_map_path, const std::string& mask_path,
-                            const BakeOptions& options, const TexturedMesh* mesh) const {
+namespace {
+
+/// The key from the content hashes (hex) of the normal map and the mask ("" for none).
+std::string keyOf(const std::string& normal_map_hash, const std::string& mask_hash,
+                  const BakeOptions& options, const TexturedMesh* mesh) {
   std::uint64_t hash = fnv1a64("norm2tex-atlas-v" + std::to_string(kFormatVersion));
-  hash = fnv1a64(hashFile(normal_map_path), hash);
-  hash = fnv1a64(mask_path.empty() ? std::string("no-mask") : hashFile(mask_path), hash);
+  hash = fnv1a64(normal_map_hash, hash);
+  hash = fnv1a64(mask_hash.empty() ? std::string("no-mask") : mask_hash, hash);
   hash = fnv1a64(describeOptions(options), hash);
   if (mesh != nullptr) {
     // What a mesh bake depends on: UV layout (charts), 3-D areas (scale) and seams.
@@ -76,6 +79,25 @@ std::string AtlasCache::key(const std::string& normal_map_path, const std::strin
     hash = fnv1a64(bytes(mesh->uvs()), hash);
   }
   return toHex(hash);
+}
+
+/// hashFile() of a file holding `bytes`: an embedded texture and the same bytes in a file
+/// share their entry.
+std::string hashBytes(const std::vector<unsigned char>& bytes) {
+  return toHex(fnv1a64(std::string(bytes.begin(), bytes.end())));
+}
+
+}  // namespace
+
+std::string AtlasCache::key(const std::string& normal_map_path, const std::string& mask_path,
+                            const BakeOptions& options, const TexturedMesh* mesh) const {
+  return keyOf(hashFile(normal_map_path), mask_path.empty() ? "" : hashFile(mask_path), options,
+               mesh);
+}
+
+std::string AtlasCache::key(const std::vector<unsigned char>& encoded_normal_map,
+                            const BakeOptions& options, const TexturedMesh* mesh) const {
+  return keyOf(hashBytes(encoded_normal_map), "", options, mesh);
 }
 
 std::optional<HeightAtlas> AtlasCache::load(const std::string& key) const {
@@ -106,6 +128,15 @@ std::optional<HeightAtlas> AtlasCache::load(const std::string& key) const {
 void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
                        const std::string& normal_map_path, const std::string& mask_path,
                        const BakeOptions& options) const {
+  storeEntry(key, atlas, fs::absolute(normal_map_path).string(), hashFile(normal_map_path),
+             mask_path.empty() ? std::string() : fs::absolute(mask_path).string(),
+             mask_path.empty() ? std::string() : hashFile(mask_path), options);
+}
+
+void AtlasCache::storeEntry(const std::string& key, const HeightAtlas& atlas,
+                            const std::string& source, const std::string& source_hash,
+                            const std::string& mask_path, const std::string& mask_hash,
+                            const BakeOptions& options) const {
   std::error_code ec;
   fs::create_directories(directory_, ec);
   if (ec) throw Error("cannot create cache directory '" + directory_ + "': " + ec.message());
@@ -125,12 +156,10 @@ void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
   yaml << YAML::BeginMap;
   yaml << YAML::Key << "format_version" << YAML::Value << kFormatVersion;
   yaml << YAML::Key << "key" << YAML::Value << key;
-  yaml << YAML::Key << "source_path" << YAML::Value << fs::absolute(normal_map_path).string();
-  yaml << YAML::Key << "source_hash" << YAML::Value << hashFile(normal_map_path);
-  yaml << YAML::Key << "mask_path" << YAML::Value
-       << (mask_path.empty() ? std::string() : fs::absolute(mask_path).string());
-  yaml << YAML::Key << "mask_hash" << YAML::Value
-       << (mask_path.empty() ? std::string() : hashFile(mask_path));
+  yaml << YAML::Key << "source_path" << YAML::Value << source;
+  yaml << YAML::Key << "source_hash" << YAML::Value << source_hash;
+  yaml << YAML::Key << "mask_path" << YAML::Value << mask_path;
+  yaml << YAML::Key << "mask_hash" << YAML::Value << mask_hash;
   yaml << YAML::Key << "parameters" << YAML::Value << describeOptions(options);
   yaml << YAML::Key << "convention" << YAML::Value << toString(options.normal_map.convention);
   yaml << YAML::Key << "range" << YAML::Value << toString(options.range);
@@ -154,14 +183,28 @@ void AtlasCache::store(const std::string& key, const HeightAtlas& atlas,
   if (ec) throw Error("cannot write cache metadata '" + final_path + "': " + ec.message());
 }
 
+namespace {
+
+/// A mesh bake learns mm per texel from the mesh (and checks the physical scale then).
+void validateForBake(const BakeOptions& options, const TexturedMesh* mesh) {
+  BakeOptions checked = options;
+  if (mesh != nullptr) checked.physical_scale = false;
+  validate(checked);
+}
+
+HeightAtlas bake(const NormalMap& normal_map, const BakeOptions& options,
+                 const BakeProgress& progress, const TexturedMesh* mesh, MeshBakeReport& report) {
+  return mesh != nullptr ? bakeHeightAtlasForMesh(normal_map, *mesh, options, progress, &report)
+                         : bakeHeightAtlas(normal_map, options, progress);
+}
+
+}  // namespace
+
 AtlasCache::Result AtlasCache::loadOrBake(const std::string& normal_map_path,
                                           const std::string& mask_path, const BakeOptions& options,
                                           const BakeProgress& progress,
                                           const TexturedMesh* mesh) const {
-  // A mesh bake learns mm per texel from the mesh (and checks the physical scale then).
-  BakeOptions checked = options;
-  if (mesh != nullptr) checked.physical_scale = false;
-  validate(checked);
+  validateForBake(options, mesh);
   Result result;
   const std::string cache_key = key(normal_map_path, mask_path, options, mesh);
   if (std::optional<HeightAtlas> cached = load(cache_key)) {
@@ -170,11 +213,38 @@ AtlasCache::Result AtlasCache::loadOrBake(const std::string& normal_map_path,
     return result;
   }
   const NormalMap normal_map = NormalMap::load(normal_map_path, options.normal_map, mask_path);
-  result.atlas = mesh != nullptr ? bakeHeightAtlasForMesh(normal_map, *mesh, options, progress,
-                                                          &result.mesh_report)
-                                 : bakeHeightAtlas(normal_map, options, progress);
+  result.atlas = bake(normal_map, options, progress, mesh, result.mesh_report);
   try {
     store(cache_key, result.atlas, normal_map_path, mask_path, options);
+  } catch (const Error& e) {
+    result.store_error = e.what();
+  }
+  return result;
+}
+
+AtlasCache::Result AtlasCache::loadOrBake(const std::vector<unsigned char>& encoded_normal_map,
+                                          const std::string& what, const BakeOptions& options,
+                                          const BakeProgress& progress,
+                                          const TexturedMesh* mesh) const {
+  validateForBake(options, mesh);
+  Result result;
+  const std::string cache_key = key(encoded_normal_map, options, mesh);
+  if (std::optional<HeightAtlas> cached = load(cache_key)) {
+    result.atlas = std::move(*cached);
+    result.was_cached = true;
+    return result;
+  }
+  const NormalMap normal_map = [&] {
+    const cv::Mat image = decodeImage(encoded_normal_map, cv::IMREAD_UNCHANGED, what);
+    try {
+      return NormalMap::fromImage(image, options.normal_map);
+    } catch (const Error& e) {
+      throw Error(what + ": " + e.what());
+    }
+  }();
+  result.atlas = bake(normal_map, options, progress, mesh, result.mesh_report);
+  try {
+    storeEntry(cache_key, result.atlas, what, hashBytes(encoded_normal_map), "", "", options);
   } catch (const Error& e) {
     result.store_error = e.what();
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <opencv2/core/hal/intrin.hpp>
@@ -59,6 +60,13 @@ HeightAtlas::HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, cv::Mat1i island_la
     }
   }
   finish();
+}
+
+cv::Mat1f HeightAtlas::takeHeightsInvalidAsNaN() && {
+  cv::Mat1f heights = std::move(heights_);
+  heights.setTo(std::numeric_limits<float>::quiet_NaN(), valid_ == 0);
+  *this = HeightAtlas();
+  return heights;
 }
 
 void HeightAtlas::finish() {

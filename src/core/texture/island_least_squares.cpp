@@ -23,8 +23,8 @@ double dot(const cv::Mat1f& a, const cv::Mat1f& b) {
 
 }  // namespace
 
-int IslandLeastSquares::buildSystem(const cv::Mat1f& dx, const cv::Mat1f& dy,
-                                    const cv::Mat1b& mask) {
+int IslandLeastSquares::buildSystem(const cv::Mat1f& dx, const cv::Mat1f& dy, const cv::Mat1b& mask,
+                                    cv::Mat1f& rhs) {
   const int rows = dx.rows, cols = dx.cols;
   flags_ = flag_buffer_.view(rows, cols);
   int count = 0;
@@ -43,27 +43,32 @@ int IslandLeastSquares::buildSystem(const cv::Mat1f& dx, const cv::Mat1f& dy,
     }
   }
   // b(p) = sum over edges into p of their target minus sum over edges out of p: -div(g).
-  rhs_ = rhs_buffer_.view(rows, cols);
-  rhs_.setTo(0.0f);
+  // Row r of b needs the slopes of rows r - 1 .. r + 1 only, so it is written over row r of
+  // dx or dy (rhs may be either): the rows it overwrites are copied first.
+  gx_row_.resize(cols);
+  gy_row_.resize(cols);
+  gy_above_.resize(cols);
   for (int r = 0; r < rows; ++r) {
     const uchar* f = flags_.ptr<uchar>(r);
-    const float* gx = dx.ptr<float>(r);
-    const float* gy = dy.ptr<float>(r);
-    const float* gy_below = r + 1 < rows ? dy.ptr<float>(r + 1) : nullptr;
-    float* b = rhs_.ptr<float>(r);
-    float* b_below = r + 1 < rows ? rhs_.ptr<float>(r + 1) : nullptr;
+    const uchar* f_above = r > 0 ? flags_.ptr<uchar>(r - 1) : nullptr;
+    std::copy(dx.ptr<float>(r), dx.ptr<float>(r) + cols, gx_row_.begin());
+    std::copy(dy.ptr<float>(r), dy.ptr<float>(r) + cols, gy_row_.begin());
+    const float* gx = gx_row_.data();
+    const float* gy = gy_row_.data();
+    const float* gy_above = gy_above_.data();
+    const float* gy_below = r + 1 < rows ? dy.ptr<float>(r + 1) : nullptr;  // not yet written
+    float* b = rhs.ptr<float>(r);
     for (int c = 0; c < cols; ++c) {
-      if (f[c] & kEdgeRight) {
-        const float target = 0.5f * (gx[c] + gx[c + 1]);
-        b[c] -= target;
-        b[c + 1] += target;
-      }
-      if (f[c] & kEdgeDown) {
-        const float target = 0.5f * (gy[c] + gy_below[c]);
-        b[c] -= target;
-        b_below[c] += target;
-      }
+      // The order of the old scatter form (edge from above, from the left, to the right,
+      // downwards), so the sums round alike.
+      float value = 0.0f;
+      if (f_above != nullptr && (f_above[c] & kEdgeDown)) value += 0.5f * (gy_above[c] + gy[c]);
+      if (c > 0 && (f[c - 1] & kEdgeRight)) value += 0.5f * (gx[c - 1] + gx[c]);
+      if (f[c] & kEdgeRight) value -= 0.5f * (gx[c] + gx[c + 1]);
+      if (f[c] & kEdgeDown) value -= 0.5f * (gy[c] + gy_below[c]);
+      b[c] = value;
     }
+    gy_above_.swap(gy_row_);
   }
   return count;
 }
@@ -117,9 +122,12 @@ void IslandLeastSquares::solve(const cv::Mat1f& dx, const cv::Mat1f& dy, const c
                                double tolerance, int max_iterations, cv::Mat1f& height,
                                IntegrationReport& report) {
   report = IntegrationReport{};
-  island_texels_ = buildSystem(dx, dy, mask);
-  height.setTo(0.0f);
-  if (island_texels_ <= 1) return;
+  // The right-hand side goes into height's memory (which may be dx or dy): no buffer of its own.
+  island_texels_ = buildSystem(dx, dy, mask, height);
+  if (island_texels_ <= 1) {
+    height.setTo(0.0f);
+    return;
+  }
   const int rows = dx.rows, cols = dx.cols;
   const int transform_rows = NeumannPoissonSolver::transformLength(rows);
   const int transform_cols = NeumannPoissonSolver::transformLength(cols);
@@ -127,7 +135,7 @@ void IslandLeastSquares::solve(const cv::Mat1f& dx, const cv::Mat1f& dy, const c
   // An island that fills a box of transform size has exactly the box's normal equations: the
   // cosine-transform solve is the least-squares solution, no iteration needed.
   if (island_texels_ == rows * cols && transform_rows == rows && transform_cols == cols) {
-    poisson_.solve(rhs_, height);
+    poisson_.solve(height, height);
     report.solves = 1;
     return;
   }
@@ -140,7 +148,8 @@ void IslandLeastSquares::solve(const cv::Mat1f& dx, const cv::Mat1f& dy, const c
 
   // Preconditioned conjugate gradients from h = 0 on A h = b, A singular with the constants
   // as null space: b and every iterate are kept at zero island mean.
-  rhs_.copyTo(residual_);
+  height.copyTo(residual_);
+  height.setTo(0.0f);
   removeIslandMean(residual_);
   precondition(residual_, preconditioned_);
   ++report.solves;

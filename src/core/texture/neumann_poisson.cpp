@@ -20,7 +20,8 @@ void NeumannPoissonSolver::prepare(int rows, int cols) {
 
 void NeumannPoissonSolver::solve(const cv::Mat1f& b, cv::Mat1f& z) {
   prepare(b.rows, b.cols);
-  cv::Mat1f& spectrum = transform_.forward(b);  // transposed: row u, column v
+  if (z.data != b.data) b.copyTo(z);            // z is the transform's working memory
+  cv::Mat1f& spectrum = transform_.forward(z);  // transposed: row u, column v
   for (int u = 0; u < cols_; ++u) {
     float* row = spectrum.ptr<float>(u);
     const float lambda_u = lambda_x_[u];

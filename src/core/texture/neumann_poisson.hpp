@@ -17,8 +17,8 @@ class NeumannPoissonSolver {
   /// Solves L z = b for z on a rows x cols grid, L the graph Laplacian of the grid's 4-neighbour
   /// edges ((L z)(p) = sum over neighbours q of z(p) - z(q)), which the cosine transform
   /// diagonalises. b must sum to ~0 (the constant part is dropped); z has zero mean. `b` and
-  /// `z` are rows x cols CV_32F and may be the same matrix. Sizes must be even: see
-  /// transformLength().
+  /// `z` are rows x cols CV_32F and may be the same matrix (then no other full-size buffer is
+  /// used for a square grid, one for others). Sizes must be even: see transformLength().
   void solve(const cv::Mat1f& b, cv::Mat1f& z);
 
   /// The smallest even length >= n whose real DFT is fast.

@@ -70,7 +70,17 @@ void ReliefFilter::removeLongWavelengths(cv::Mat1f& dx, cv::Mat1f& dy, const cv:
   blur(weight, coarse_sigma);
 
   // Bilinear back to full resolution: coarse cell i is centred on texel factor (i + 1/2) - 1/2.
+  // The columns' cells and weights are the same on every row: computed once.
   const float scale = 1.0f / static_cast<float>(factor);
+  column_x0_.resize(mask.cols);
+  column_x1_.resize(mask.cols);
+  column_fx_.resize(mask.cols);
+  for (int c = 0; c < mask.cols; ++c) {
+    const float x = std::max(0.0f, (c + 0.5f) * scale - 0.5f);
+    column_x0_[c] = std::min(static_cast<int>(x), cols - 1);
+    column_x1_[c] = std::min(column_x0_[c] + 1, cols - 1);
+    column_fx_[c] = std::min(1.0f, x - static_cast<float>(column_x0_[c]));
+  }
   for (int r = 0; r < mask.rows; ++r) {
     const float y = std::max(0.0f, (r + 0.5f) * scale - 0.5f);
     const int y0 = std::min(static_cast<int>(y), rows - 1), y1 = std::min(y0 + 1, rows - 1);
@@ -78,19 +88,21 @@ void ReliefFilter::removeLongWavelengths(cv::Mat1f& dx, cv::Mat1f& dy, const cv:
     const uchar* in = mask.ptr<uchar>(r);
     float* gx = dx.ptr<float>(r);
     float* gy = dy.ptr<float>(r);
+    const float *sx0 = sum_x.ptr<float>(y0), *sx1 = sum_x.ptr<float>(y1);
+    const float *sy0 = sum_y.ptr<float>(y0), *sy1 = sum_y.ptr<float>(y1);
+    const float *w0 = weight.ptr<float>(y0), *w1 = weight.ptr<float>(y1);
     for (int c = 0; c < mask.cols; ++c) {
       if (!in[c]) continue;
-      const float x = std::max(0.0f, (c + 0.5f) * scale - 0.5f);
-      const int x0 = std::min(static_cast<int>(x), cols - 1), x1 = std::min(x0 + 1, cols - 1);
-      const float fx = std::min(1.0f, x - static_cast<float>(x0));
-      const auto at = [&](const cv::Mat1f& m) {
-        return (1 - fy) * ((1 - fx) * m(y0, x0) + fx * m(y0, x1)) +
-               fy * ((1 - fx) * m(y1, x0) + fx * m(y1, x1));
+      const int x0 = column_x0_[c], x1 = column_x1_[c];
+      const float fx = column_fx_[c];
+      const auto at = [&](const float* top, const float* bottom) {
+        return (1 - fy) * ((1 - fx) * top[x0] + fx * top[x1]) +
+               fy * ((1 - fx) * bottom[x0] + fx * bottom[x1]);
       };
       // The island's own texels keep the blurred weight above zero near them.
-      const float w = std::max(at(weight), 1e-12f);
-      gx[c] -= at(sum_x) / w;
-      gy[c] -= at(sum_y) / w;
+      const float w = std::max(at(w0, w1), 1e-12f);
+      gx[c] -= at(sx0, sx1) / w;
+      gy[c] -= at(sy0, sy1) / w;
     }
   }
 }

@@ -2,6 +2,8 @@
 // Relief, not drift: the Gaussian high-pass that keeps an island's fine relief and drops the
 // long-wavelength drift that integration of a real normal map accumulates.
 
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 #include "texture/cosine_transform.hpp"
@@ -35,6 +37,8 @@ class ReliefFilter {
 
   CosineTransform transform_;
   ScratchBuffer<float> sum_x_, sum_y_, weight_;
+  std::vector<int> column_x0_, column_x1_;  // per full-resolution column: its coarse cells
+  std::vector<float> column_fx_;            // and the weight of the second
 };
 
 }  // namespace detail

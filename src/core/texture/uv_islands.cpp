@@ -12,6 +12,13 @@ UvIslands findUvIslands(const cv::Mat1b& valid) {
   UvIslands result;
   cv::Mat stats, centroids;
   createWithHugePages(result.labels, valid.rows, valid.cols);  // a bake's largest label map
+  // Every texel valid (a tiling texture without alpha, the common case): one island, the
+  // whole map. connectedComponents would first clear a 32 MB table at 4096^2 for this.
+  if (cv::countNonZero(valid) == valid.rows * valid.cols) {
+    result.labels.setTo(1);
+    result.islands.push_back({1, cv::Rect(0, 0, valid.cols, valid.rows), valid.rows * valid.cols});
+    return result;
+  }
   const int count =
       cv::connectedComponentsWithStats(valid, result.labels, stats, centroids, 4, CV_32S);
   result.islands.reserve(count > 0 ? count - 1 : 0);
