@@ -111,6 +111,7 @@ Eigen::Isometry3d pressed(double press_mm) {
 
 TEST(ObjectTexture, EmbeddedGlbNormalTextureIsBakedAndRendersTextured) {
   test::ScratchDirectory dir;
+  setenv("NORM2TEX_CACHE_DIR", dir.path("cache").c_str(), 1);  // a cold cache of its own
   const std::vector<unsigned char> png = ridgesPng();
   writeSquareGlb(dir.path("square.glb"), png);
   const auto mesh =
@@ -147,6 +148,17 @@ TEST(ObjectTexture, EmbeddedGlbNormalTextureIsBakedAndRendersTextured) {
   const cv::Mat3b plain = renderer.render(pressed(0.3), -1).image;
   EXPECT_GT(cv::norm(textured_image, plain, cv::NORM_L1) / plain.total(), 1.0)
       << "the texture shows in the image";
+
+  // The next start (a new mesh load, the same file) finds the bake in the cache: the same
+  // heights and island labels, nothing baked.
+  const ObjectTexture again = loadTextureFile({}, TexturedMesh::load(dir.path("square.glb")));
+  ASSERT_NE(again.atlas, nullptr) << again.warning;
+  EXPECT_NE(again.description.find("(cached)"), std::string::npos) << again.description;
+  EXPECT_EQ(cv::norm(again.atlas->heights(), texture.atlas->heights(), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::countNonZero(again.atlas->islandLabels() != texture.atlas->islandLabels()), 0);
+  EXPECT_TRUE(again.physical_scale);
+  EXPECT_EQ(again.beta_mm, 1.0);
+  unsetenv("NORM2TEX_CACHE_DIR");
 }
 
 TEST(ObjectTexture, MissingOrUnusableMeshTextureIsAWarningNamingIt) {

@@ -37,8 +37,9 @@ struct ObjectTexture {
 /// A normal map (baked through the AtlasCache), an atlas file, or with neither the mesh's own
 /// normal texture: a file next to the mesh or embedded in it (GLB "*N"). The mesh's own
 /// texture is baked for the mesh (bakeHeightAtlasForMesh: its UV charts as islands, offsets
-/// matched at seams) at physical scale, so H_global is in mm and beta_mm is 1; a file texture
-/// through the AtlasCache under a key that covers the mesh, an embedded one from memory. Throws Error naming the file for a given normal map or atlas,
+/// matched at seams) at physical scale, so H_global is in mm and beta_mm is 1, through the
+/// AtlasCache under a key that covers the mesh (an embedded texture keyed by its bytes). Throws
+/// Error naming the file for a given normal map or atlas,
 /// or when `source` names a material; the mesh's own texture, when missing or unusable, gives no
 /// atlas and a warning naming it as the mesh's normal texture (the mesh still renders).
 ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& mesh);

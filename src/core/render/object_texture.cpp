@@ -123,16 +123,17 @@ ObjectTexture loadTextureFile(const TextureSource& source, const TexturedMesh& m
                     "files are); rendering without texture";
       return out;
     } else {
-      // Embedded (GLB "*N", data URI): baked from memory, not cached (no file to key on).
-      const NormalMap normal_map = NormalMap::fromImage(
-          decodeImage(mesh.embeddedNormalTexture(), cv::IMREAD_UNCHANGED, what),
-          options.normal_map);
-      MeshBakeReport report;
-      out.atlas = std::make_shared<HeightAtlas>(
-          mesh.hasUvs() ? bakeHeightAtlasForMesh(normal_map, mesh, for_mesh, {}, &report)
-                        : bakeHeightAtlas(normal_map, options));
+      // Embedded (GLB "*N", data URI): cached under its bytes (and the mesh), like a file.
+      const AtlasCache cache(AtlasCache::defaultDirectory());
+      AtlasCache::Result result =
+          mesh.hasUvs() ? cache.loadOrBake(mesh.embeddedNormalTexture(), what, for_mesh, {}, &mesh)
+                        : cache.loadOrBake(mesh.embeddedNormalTexture(), what, options);
+      out.warning = result.store_error;
+      out.atlas = std::make_shared<HeightAtlas>(std::move(result.atlas));
       out.description = "the mesh's normal texture " + reference +
-                        (mesh.hasUvs() ? describeMeshBake(report) : std::string(" (baked)"));
+                        (result.was_cached ? std::string(" (cached)")
+                         : mesh.hasUvs()   ? describeMeshBake(result.mesh_report)
+                                           : std::string(" (baked)"));
     }
     if (mesh.hasUvs()) {
       out.beta_mm = 1.0;
