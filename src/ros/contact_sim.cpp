@@ -133,13 +133,16 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   service_spinner_->start();
-  if (!params_.synchronous) {
-    clock_thread_ = std::thread(&ContactSim::runClock, this);
-  }
   object_marker_pub_.publish(ros_conversions::objectMarker(sim_->object().mesh, ros::Time(0)));
-  // Synchronous renderers get their first frame with the first step (or reset); publishing one
-  // now would wait for renderers that may not have started yet.
-  if (!params_.synchronous || params_.renderers.empty()) publishFrame();
+  {
+    // The services already run: the first frame is published under the same lock.
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Synchronous renderers get their first frame with the first step (or reset); publishing
+    // one now would wait for renderers that may not have started yet.
+    if (!params_.synchronous || params_.renderers.empty()) publishFrame();
+  }
+  // Last: the clock's ticks may only come once everything above is in place.
+  if (!params_.synchronous) clock_thread_ = std::thread(&ContactSim::runClock, this);
   ROS_INFO(
       "contact_sim: %s mode, scene %s, material %s (friction %.2f), physics %.0f Hz "
       "(%d ticks per %.1f Hz frame), object '%s' %s",
