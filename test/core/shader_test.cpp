@@ -283,20 +283,33 @@ TEST(ShaderLedTest, EachLedLightsTheSideFacingItAtVgaAndOnADome) {
   expectLedSides(dome, dome_shader, sphericalCap(dome, 3.0, 0.5));
 }
 
-// A ball of 8.8 mm pressed 1.5 mm: real DIGIT presses of such a ball differ from the
-// background by ~29 grey levels on average inside the contact (95th percentile ~48) and by
-// little away from it.
+// A ball of 8.8 mm pressed 1.5 mm through the gel model: real DIGIT presses of such a ball
+// (two units, depth not recorded) differ from the background by 28-29 grey levels on average
+// inside the contact, with a 95th percentile of 76-78 per channel, and by little away from it.
+// Measured here: 32.8 and 80. (The calibrated shading of the shipped unit gives 45.6 and 116
+// at this depth, 33.5 and 81 at 1.0 mm; it is checked against real presses of its own unit in
+// calibrate_test.)
 TEST(ShaderLedTest, AnalyticBallPressHasRealisticMagnitudes) {
   const SensorModel model = analyticModel();
   const cv::Mat3b background = makeSyntheticBackground(model.imageSize());
   const DigitShader shader(model, background, kSynthetic);
   const cv::Mat1f raw = sphericalCap(model, 4.4, 1.5);
-  const cv::Mat1f h = smoothed(raw, model, 0.3);
+  cv::Mat1f h;
+  GelModel(model).apply(raw, h);
   const cv::Mat3f diff = difference(shader.shade(h, -1), background);
   const cv::Mat1b contact = raw > 0.0f;
-  const double inside = meanAbs(diff, contact);
-  EXPECT_GT(inside, 10.0);
-  EXPECT_LT(inside, 60.0);
+  EXPECT_NEAR(meanAbs(diff, contact), 28.5, 0.3 * 28.5);
+  for (int k = 0; k < 3; ++k) {
+    std::vector<float> inside;
+    for (int r = 0; r < diff.rows; ++r) {
+      for (int c = 0; c < diff.cols; ++c) {
+        if (contact(r, c)) inside.push_back(std::fabs(diff(r, c)[k]));
+      }
+    }
+    const auto p95 = inside.begin() + static_cast<std::ptrdiff_t>(0.95 * (inside.size() - 1));
+    std::nth_element(inside.begin(), p95, inside.end());
+    EXPECT_NEAR(*p95, 77.0, 0.3 * 77.0) << "channel " << k;
+  }
   const double contact_radius_px = std::sqrt(2 * 4.4 * 1.5 - 1.5 * 1.5) / model.mm_per_pixel;
   cv::Mat1b far(h.size(), 255);
   cv::circle(far, cv::Point(model.cols / 2, model.rows / 2), cvRound(1.5 * contact_radius_px), 0,
