@@ -9,7 +9,7 @@ namespace norm2tex {
 /// Why: on our VMs the first touch of a fresh 4 KB page costs ~13 us. By default glibc maps
 /// blocks over 128 KB (adaptively up to 32 MB) fresh and unmaps them on free, so a process that
 /// renders frames, writes bags or bakes textures again and again faults the same memory in
-/// over and over: a wood variant's texture took 400 ms instead of 260 ms (and calibration ~3x).
+/// over and over: a wood variant's texture took 400 ms instead of 260 ms.
 /// Long-running nodes and repeated-work tools call this once at start.
 bool keepFreedMemoryForReuse();
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -37,9 +38,23 @@ cv::Size kernelFor(double sigma_px) {
 // calls (compare, boundingRect, masked copies, min, masked set), a dozen full-image passes and
 // temporaries that cost about as much as the blurs.
 
+/// The bounding box of per-row spans [first, last], grown one row at a time.
+struct SpanBox {
+  int top = -1, bottom = -1, left = std::numeric_limits<int>::max(), right = -1;
+  void add(int row, int first, int last) {
+    if (top < 0) top = row;
+    bottom = row;
+    left = std::min(left, first);
+    right = std::max(right, last);
+  }
+  cv::Rect rect() const {
+    return top < 0 ? cv::Rect() : cv::Rect(left, top, right - left + 1, bottom - top + 1);
+  }
+};
+
 /// Bounding box of the values above kNegligibleMm (empty when none).
 cv::Rect deformationBox(const cv::Mat1f& field) {
-  int top = -1, bottom = -1, left = field.cols, right = -1;
+  SpanBox box;
   for (int r = 0; r < field.rows; ++r) {
     const float* row = field.ptr<float>(r);
     int first = 0;
@@ -47,13 +62,9 @@ cv::Rect deformationBox(const cv::Mat1f& field) {
     if (first == field.cols) continue;
     int last = field.cols - 1;
     while (!(row[last] > kNegligibleMm)) --last;
-    if (top < 0) top = r;
-    bottom = r;
-    left = std::min(left, first);
-    right = std::max(right, last);
+    box.add(r, first, last);
   }
-  if (top < 0) return {};
-  return {left, top, right - left + 1, bottom - top + 1};
+  return box.rect();
 }
 
 /// out = keep ? a : b for one row; both sides read, so it compiles to vector blends, not to a
@@ -76,24 +87,17 @@ void restoreCore(const cv::Mat1f& in, const cv::Mat1b& core, cv::Mat1f& out) {
 
 /// Bounding box of the pixels of `box` outside the core (empty when the core covers it).
 cv::Rect outsideCoreBox(const cv::Mat1b& core, const cv::Rect& box) {
-  int top = -1, bottom = -1, left = box.x + box.width, right = -1;
+  SpanBox outside;
+  const auto width = static_cast<std::size_t>(box.width);
   for (int r = box.y; r < box.y + box.height; ++r) {
     // A core row is mostly 255: memchr/memrchr find its first and last 0 a vector at a time.
     const uchar* row = core.ptr<uchar>(r) + box.x;
-    const void* first_gap = std::memchr(row, 0, static_cast<std::size_t>(box.width));
-    if (first_gap == nullptr) continue;
-    const int first = box.x + static_cast<int>(static_cast<const uchar*>(first_gap) - row);
-    const int last =
-        box.x +
-        static_cast<int>(
-            static_cast<const uchar*>(memrchr(row, 0, static_cast<std::size_t>(box.width))) - row);
-    if (top < 0) top = r;
-    bottom = r;
-    left = std::min(left, first);
-    right = std::max(right, last);
+    const auto* first = static_cast<const uchar*>(std::memchr(row, 0, width));
+    if (first == nullptr) continue;
+    const auto* last = static_cast<const uchar*>(memrchr(row, 0, width));
+    outside.add(r, box.x + static_cast<int>(first - row), box.x + static_cast<int>(last - row));
   }
-  if (top < 0) return {};
-  return {left, top, right - left + 1, bottom - top + 1};
+  return outside.rect();
 }
 
 /// Gaussian blur of `field` restricted to the bounding box of its non-negligible values, grown
