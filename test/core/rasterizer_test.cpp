@@ -1,5 +1,6 @@
 // ContactRasterizer: watertight coverage (every pixel exactly once under a closed surface seen
 // from one side) and thread safety of the const rasterize().
+#include <algorithm>
 #include <cmath>
 #include <thread>
 #include <vector>
@@ -111,6 +112,95 @@ TEST(ContactRasterizer, CentresExactlyOnEdgesAndCornersAreDrawnOnce) {
   }
   expectEveryPixelExactlyOnce(makeGrid(6, 30.0, 0.0, model, true), flipped, model,
                               "wide triangles on pixel centres, flipped");
+}
+
+/// A square of two triangles, `extent_mm` across, on the plane z = z0 + zx x + zy y (mm, object
+/// frame), with u = 0.5 + x / 40 mm and v = 0.5 + y / 60 mm (also affine, so exact for any
+/// triangulation).
+struct TiltedPlane {
+  double z0, zx, zy;
+  double z(double x, double y) const { return z0 + zx * x + zy * y; }
+  static cv::Vec2f uv(double x, double y) {
+    return cv::Vec2f(static_cast<float>(0.5 + x / 40.0), static_cast<float>(0.5 + y / 60.0));
+  }
+};
+
+void addPlane(const TiltedPlane& plane, double extent_mm, std::vector<Eigen::Vector3f>& vertices,
+              std::vector<Eigen::Vector2f>& uvs, std::vector<Eigen::Vector3i>& triangles) {
+  const int first = static_cast<int>(vertices.size());
+  const double h = 0.5 * extent_mm;
+  for (const auto& [x, y] :
+       {std::pair{-h, -h}, std::pair{h, -h}, std::pair{h, h}, std::pair{-h, h}}) {
+    vertices.emplace_back(static_cast<float>(x * 1e-3), static_cast<float>(y * 1e-3),
+                          static_cast<float>(plane.z(x, y) * 1e-3));
+    const cv::Vec2f uv = TiltedPlane::uv(x, y);
+    uvs.emplace_back(uv[0], uv[1]);
+  }
+  triangles.emplace_back(first, first + 1, first + 2);
+  triangles.emplace_back(first, first + 2, first + 3);
+}
+
+/// Rasterizes `planes` (see addPlane) twice, the second frame starting from the first's raster
+/// (only its covered box is cleared), and checks every pixel against the nearest plane.
+void expectNearestPlaneEverywhere(const std::vector<TiltedPlane>& planes, double reach_mm,
+                                  const std::string& what) {
+  const SensorModel model = makeDigitSensorModel();
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Eigen::Vector2f> uvs;
+  std::vector<Eigen::Vector3i> triangles;
+  for (const TiltedPlane& plane : planes) addPlane(plane, 40.0, vertices, uvs, triangles);
+  const TexturedMesh mesh(std::move(vertices), std::move(triangles), std::move(uvs));
+  const ContactRasterizer rasterizer(model);
+  ContactRaster raster;
+  for (int frame = 0; frame < 2; ++frame) {
+    SCOPED_TRACE(what + ", frame " + std::to_string(frame));
+    rasterizer.rasterize(mesh, Eigen::Isometry3d::Identity(), reach_mm, true, raster);
+    int wrong_gap = 0, wrong_uv = 0, wrong_face = 0, wrong_empty = 0, covered = 0;
+    std::vector<int> wins(planes.size(), 0);
+    cv::Rect expected_box;
+    for (int r = 0; r < model.rows; ++r) {
+      for (int c = 0; c < model.cols; ++c) {
+        const cv::Point2d p = model.pixelToGelMm(r, c);
+        std::vector<double> z;
+        for (const TiltedPlane& plane : planes) z.push_back(plane.z(p.x, p.y));
+        const auto nearest = std::min_element(z.begin(), z.end());
+        const int winner = static_cast<int>(nearest - z.begin());
+        if (*nearest > reach_mm + 1e-4) {
+          wrong_empty += std::isinf(raster.gap_mm(r, c)) && raster.face(r, c) < 0 ? 0 : 1;
+          continue;
+        }
+        if (*nearest > reach_mm - 1e-4) continue;  // at the reach: float rounding decides
+        ++covered;
+        expected_box |= cv::Rect(c, r, 1, 1);
+        wrong_gap += std::abs(raster.gap_mm(r, c) - *nearest) < 1e-4 ? 0 : 1;
+        const bool tie = std::count_if(z.begin(), z.end(),
+                                       [&](double other) { return other < *nearest + 1e-4; }) > 1;
+        if (tie) continue;  // on a crossing: either plane is right
+        ++wins[winner];
+        wrong_face += raster.face(r, c) / 2 == winner ? 0 : 1;  // two triangles per plane
+        wrong_uv += cv::norm(raster.uv(r, c) - TiltedPlane::uv(p.x, p.y)) < 1e-5 ? 0 : 1;
+      }
+    }
+    EXPECT_GT(covered, model.rows * model.cols / 4);
+    for (const int w : wins) EXPECT_GT(w, covered / 10) << "every plane is nearest somewhere";
+    EXPECT_EQ(wrong_gap, 0);
+    EXPECT_EQ(wrong_uv, 0);
+    EXPECT_EQ(wrong_face, 0);
+    EXPECT_EQ(wrong_empty, 0) << "pixels above the reach stay empty";
+    // The box of written pixels: the expected one, give or take the pixels at the reach.
+    EXPECT_LE(std::abs(raster.covered_box.x - expected_box.x), 1);
+    EXPECT_LE(std::abs(raster.covered_box.y - expected_box.y), 1);
+    EXPECT_LE(std::abs(raster.covered_box.br().x - expected_box.br().x), 1);
+    EXPECT_LE(std::abs(raster.covered_box.br().y - expected_box.br().y), 1);
+  }
+}
+
+TEST(ContactRasterizer, WideTrianglesGiveTheExactGapUvAndNearestSurfacePerPixel) {
+  // Triangles far wider than the image: every row is a few long spans (the vectorised fill).
+  // Two crossing planes: the depth test flips between them along each row. One plane rising to
+  // the left: the reach cuts each row in the middle of a span, so the covered box starts there.
+  expectNearestPlaneEverywhere({{-0.2, 0.05, 0.02}, {0.1, -0.06, 0.01}}, 0.25, "crossing planes");
+  expectNearestPlaneEverywhere({{0.2, -0.05, 0.003}}, 0.25, "one plane cut by the reach");
 }
 
 TEST(ContactRasterizer, TwoThreadsSharingOneRasterizerGiveTheSameRastersAsOne) {

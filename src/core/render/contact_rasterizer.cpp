@@ -6,7 +6,12 @@
 #include <limits>
 #include <type_traits>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/simd_dispatch.hpp"
 
 namespace norm2tex {
 namespace {
@@ -82,6 +87,143 @@ template <typename T>
 bool fillTriangle(const T* x, const T* y, T one_pixel, const ProjectedTriangle& triangle, int face,
                   float reach, bool want_uv, const PixelRange& range,
                   const cv::Mat1f& gel_surface_mm, ContactRaster& out, CoveredBox& covered);
+
+/// One row's span of a wide triangle: its edge functions (exact integers, held in doubles, see
+/// fillTriangle) at the span's first column and their steps per column, and what is written.
+struct Span {
+  double e0, e1, step0, step1, inverse_area;
+  float z[3], u[3], v[3];
+  float reach;
+  int face;
+};
+
+/// Depth test and writes over columns [begin, n) of a span where every pixel centre is inside
+/// the triangle, one pixel at a time: the same operations in the same order as the per-pixel
+/// loop of fillTriangle. Widens [lo, hi] to the written columns.
+template <bool kUv>
+NORM2TEX_ALWAYS_INLINE void fillSpanScalar(int begin, int n, const Span& s, const float* gel,
+                                           float* gap_row, int* face_row, float* uv_row, int& lo,
+                                           int& hi) {
+  for (int i = begin; i < n; ++i) {
+    const double k = static_cast<double>(i);
+    const float w0 = static_cast<float>((s.e0 + k * s.step0) * s.inverse_area);
+    const float w1 = static_cast<float>((s.e1 + k * s.step1) * s.inverse_area);
+    const float w2 = 1.0f - w0 - w1;
+    const float gap = w0 * s.z[0] + w1 * s.z[1] + w2 * s.z[2] - gel[i];
+    if (gap >= gap_row[i] || gap > s.reach) continue;
+    gap_row[i] = gap;
+    face_row[i] = s.face;
+    if constexpr (kUv) {
+      uv_row[2 * i] = w0 * s.u[0] + w1 * s.u[1] + w2 * s.u[2];
+      uv_row[2 * i + 1] = w0 * s.v[0] + w1 * s.v[1] + w2 * s.v[2];
+    }
+    lo = std::min(lo, i);
+    hi = std::max(hi, i);
+  }
+}
+
+using FillSpan = void (*)(int, const Span&, const float*, float*, int*, float*, int&, int&);
+
+void fillSpanBaseline(int n, const Span& s, const float* gel, float* gap_row, int* face_row,
+                      float* uv_row, int& lo, int& hi) {
+  if (uv_row != nullptr) {
+    fillSpanScalar<true>(0, n, s, gel, gap_row, face_row, uv_row, lo, hi);
+  } else {
+    fillSpanScalar<false>(0, n, s, gel, gap_row, face_row, uv_row, lo, hi);
+  }
+}
+
+#if NORM2TEX_HAS_AVX2_BUILD
+/// Eight columns' barycentric weight: (e + k step) / area in doubles, rounded to float.
+NORM2TEX_TARGET_AVX2 inline __m256 spanWeight(__m256d e, __m256d step, __m256d k_low,
+                                              __m256d k_high, __m256d inverse_area) {
+  const __m128 low =
+      _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e, _mm256_mul_pd(k_low, step)), inverse_area));
+  const __m128 high =
+      _mm256_cvtpd_ps(_mm256_mul_pd(_mm256_add_pd(e, _mm256_mul_pd(k_high, step)), inverse_area));
+  return _mm256_set_m128(high, low);
+}
+
+/// w0 c0 + w1 c1 + w2 c2, in that order.
+NORM2TEX_TARGET_AVX2 inline __m256 spanInterpolate(__m256 w0, __m256 w1, __m256 w2,
+                                                   const float* corner) {
+  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w0, _mm256_set1_ps(corner[0])),
+                                     _mm256_mul_ps(w1, _mm256_set1_ps(corner[1]))),
+                       _mm256_mul_ps(w2, _mm256_set1_ps(corner[2])));
+}
+
+/// fillSpanScalar, eight pixels a step (the compiler does not vectorise the depth test's
+/// selective writes by itself). Identical floats: the same operations in the same order, each
+/// correctly rounded, and no FMA.
+template <bool kUv>
+NORM2TEX_TARGET_AVX2 void fillSpanAvx2Body(int n, const Span& s, const float* gel, float* gap_row,
+                                           int* face_row, float* uv_row, int& lo, int& hi) {
+  const __m256d e0 = _mm256_set1_pd(s.e0), e1 = _mm256_set1_pd(s.e1);
+  const __m256d step0 = _mm256_set1_pd(s.step0), step1 = _mm256_set1_pd(s.step1);
+  const __m256d inverse_area = _mm256_set1_pd(s.inverse_area);
+  const __m256d lanes_low = _mm256_setr_pd(0, 1, 2, 3), lanes_high = _mm256_setr_pd(4, 5, 6, 7);
+  const __m256 one = _mm256_set1_ps(1.0f), reach = _mm256_set1_ps(s.reach);
+  const __m256 z0 = _mm256_set1_ps(s.z[0]), z1 = _mm256_set1_ps(s.z[1]),
+               z2 = _mm256_set1_ps(s.z[2]);
+  const __m256 face = _mm256_castsi256_ps(_mm256_set1_epi32(s.face));
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256d first = _mm256_set1_pd(static_cast<double>(i));
+    const __m256d k_low = _mm256_add_pd(first, lanes_low),
+                  k_high = _mm256_add_pd(first, lanes_high);
+    const __m256 w0 = spanWeight(e0, step0, k_low, k_high, inverse_area);
+    const __m256 w1 = spanWeight(e1, step1, k_low, k_high, inverse_area);
+    const __m256 w2 = _mm256_sub_ps(_mm256_sub_ps(one, w0), w1);
+    const __m256 gap =
+        _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(w0, z0), _mm256_mul_ps(w1, z1)),
+                                    _mm256_mul_ps(w2, z2)),
+                      _mm256_loadu_ps(gel + i));
+    const __m256 old_gap = _mm256_loadu_ps(gap_row + i);
+    // Kept where the scalar loop skips: gap >= old gap, or gap > reach.
+    const __m256 keep = _mm256_or_ps(_mm256_cmp_ps(gap, old_gap, _CMP_GE_OQ),
+                                     _mm256_cmp_ps(gap, reach, _CMP_GT_OQ));
+    const int written = ~_mm256_movemask_ps(keep) & 0xff;
+    if (written == 0) continue;
+    _mm256_storeu_ps(gap_row + i, _mm256_blendv_ps(gap, old_gap, keep));
+    float* face_out = reinterpret_cast<float*>(face_row + i);
+    _mm256_storeu_ps(face_out, _mm256_blendv_ps(face, _mm256_loadu_ps(face_out), keep));
+    if constexpr (kUv) {
+      const __m256 u = spanInterpolate(w0, w1, w2, s.u), v = spanInterpolate(w0, w1, w2, s.v);
+      // Interleave to u0 v0 u1 v1 ...: unpack works within 128-bit halves, the permutes
+      // put the halves in order.
+      const __m256 mixed_low = _mm256_unpacklo_ps(u, v), mixed_high = _mm256_unpackhi_ps(u, v);
+      const __m256 keep_low = _mm256_unpacklo_ps(keep, keep);
+      const __m256 keep_high = _mm256_unpackhi_ps(keep, keep);
+      const __m256 uv_first = _mm256_permute2f128_ps(mixed_low, mixed_high, 0x20);
+      const __m256 uv_second = _mm256_permute2f128_ps(mixed_low, mixed_high, 0x31);
+      const __m256 keep_first = _mm256_permute2f128_ps(keep_low, keep_high, 0x20);
+      const __m256 keep_second = _mm256_permute2f128_ps(keep_low, keep_high, 0x31);
+      float* uv_out = uv_row + 2 * i;
+      _mm256_storeu_ps(uv_out, _mm256_blendv_ps(uv_first, _mm256_loadu_ps(uv_out), keep_first));
+      _mm256_storeu_ps(uv_out + 8,
+                       _mm256_blendv_ps(uv_second, _mm256_loadu_ps(uv_out + 8), keep_second));
+    }
+    lo = std::min(lo, i + __builtin_ctz(static_cast<unsigned>(written)));
+    hi = std::max(hi, i + 31 - __builtin_clz(static_cast<unsigned>(written)));
+  }
+  fillSpanScalar<kUv>(i, n, s, gel, gap_row, face_row, uv_row, lo, hi);
+}
+
+NORM2TEX_TARGET_AVX2 void fillSpanAvx2(int n, const Span& s, const float* gel, float* gap_row,
+                                       int* face_row, float* uv_row, int& lo, int& hi) {
+  if (uv_row != nullptr) {
+    fillSpanAvx2Body<true>(n, s, gel, gap_row, face_row, uv_row, lo, hi);
+  } else {
+    fillSpanAvx2Body<false>(n, s, gel, gap_row, face_row, uv_row, lo, hi);
+  }
+}
+const FillSpan fillSpan = pickSimd<FillSpan>(fillSpanAvx2, fillSpanBaseline);
+#else
+const FillSpan fillSpan = fillSpanBaseline;
+#endif
+
+/// Integers below this are exact in a double, and so are their sums below 2^53.
+constexpr double kExactInDouble = 4503599627370496.0;  // 2^52
 
 /// Smallest integer >= value / unit (unit > 0), for integers and doubles alike.
 std::int64_t ceilDiv(std::int64_t value, std::int64_t unit) {
@@ -207,6 +349,36 @@ bool fillTriangle(const T* x, const T* y, T one_pixel, const ProjectedTriangle& 
       }
       if (c_first > c_last) continue;
       for (int k = 0; k < 3; ++k) e[k] += static_cast<T>(c_first - range.c_begin) * step[k];
+      // Every centre of the span is inside: the vectorised span fill, when the edge functions
+      // along it stay exact in doubles (always, short of corners millions of pixels away).
+      const int n = c_last - c_first + 1;
+      const auto exact = [n](T e_k, T s_k) {
+        return std::abs(static_cast<double>(e_k)) < kExactInDouble &&
+               std::abs(static_cast<double>(s_k)) * n < kExactInDouble;
+      };
+      if (exact(e[0], step[0]) && exact(e[1], step[1])) {
+        const Span span{static_cast<double>(e[0]),
+                        static_cast<double>(e[1]),
+                        static_cast<double>(step[0]),
+                        static_cast<double>(step[1]),
+                        inverse_area,
+                        {z[0], z[1], z[2]},
+                        {uv[0].x(), uv[1].x(), uv[2].x()},
+                        {uv[0].y(), uv[1].y(), uv[2].y()},
+                        reach,
+                        face};
+        int lo = n, hi = -1;
+        fillSpan(n, span, gel_row + c_first, gap_row + c_first, face_row + c_first,
+                 uv_row != nullptr ? &uv_row[c_first][0] : nullptr, lo, hi);
+        out.pixel_hits += n;
+        if (lo <= hi) {
+          covered.min_r = std::min(covered.min_r, r);
+          covered.max_r = std::max(covered.max_r, r);
+          covered.min_c = std::min(covered.min_c, c_first + lo);
+          covered.max_c = std::max(covered.max_c, c_first + hi);
+        }
+        continue;
+      }
     }
     for (int col = c_first; col <= c_last;
          ++col, e[0] += step[0], e[1] += step[1], e[2] += step[2]) {

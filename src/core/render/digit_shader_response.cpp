@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/simd_dispatch.hpp"
 
 namespace norm2tex {
 namespace {
@@ -67,10 +68,8 @@ void blurWide(const cv::Mat1f& gel_mm, const cv::Rect& region, double sigma_px, 
 }
 
 // The per-pixel sums of the fused shading over one row (computeShadingDifference), and the
-// differences they start from: plain loops that the compiler vectorises. With GCC or Clang on
-// x86-64 each is built twice, for AVX2 (8 pixels a step) and for the x86-64 baseline (SSE2, 4),
-// and a CPU feature test picks one when the library loads. Both do the same operations in the
-// same order per pixel, so they give the same floats (ISO C++ mode: no contraction into FMAs).
+// differences they start from: plain loops that the compiler vectorises, built for AVX2 and the
+// baseline (simd_dispatch.hpp).
 constexpr int kVarying = 6;   // slope_x, slope_y, rim_right, rim_left, rim_down, rim_up
 constexpr int kConstant = 6;  // slope_xx, slope_xy, slope_yy, depth, rim_out, rim_in
 
@@ -78,12 +77,6 @@ constexpr int kConstant = 6;  // slope_xx, slope_xy, slope_yy, depth, rim_out, r
 struct RowCoefficients {
   float a[3][kVarying], b[3][kVarying], fixed[3][kConstant];
 };
-
-#if defined(__GNUC__)
-#define NORM2TEX_ALWAYS_INLINE __attribute__((always_inline)) inline
-#else
-#define NORM2TEX_ALWAYS_INLINE inline
-#endif
 
 NORM2TEX_ALWAYS_INLINE void shadeRowBody(int n, const float* __restrict gx,
                                          const float* __restrict gy, const float* __restrict hh,
@@ -148,13 +141,13 @@ void differencesBaseline(int first, int last, const float* h_row, const float* h
                   gx, gy, hh, rim, bx, by);
 }
 
-#if defined(__GNUC__) && defined(__x86_64__)
-__attribute__((target("avx2"))) void differencesAvx2(int first, int last, const float* h_row,
-                                                     const float* h_up, const float* h_down,
-                                                     const float* b_row, const float* b_up,
-                                                     const float* b_down, float half_inv_pixel,
-                                                     float dy_scale, float* gx, float* gy,
-                                                     float* hh, float* rim, float* bx, float* by) {
+#if NORM2TEX_HAS_AVX2_BUILD
+NORM2TEX_TARGET_AVX2 void differencesAvx2(int first, int last, const float* h_row,
+                                          const float* h_up, const float* h_down,
+                                          const float* b_row, const float* b_up,
+                                          const float* b_down, float half_inv_pixel, float dy_scale,
+                                          float* gx, float* gy, float* hh, float* rim, float* bx,
+                                          float* by) {
   differencesBody(first, last, h_row, h_up, h_down, b_row, b_up, b_down, half_inv_pixel, dy_scale,
                   gx, gy, hh, rim, bx, by);
 }
@@ -170,23 +163,18 @@ void shadeRowBaseline(int n, const float* gx, const float* gy, const float* hh, 
   shadeRowBody(n, gx, gy, hh, rim, bx, by, u0, du, k, out_b, out_g, out_r);
 }
 
-#if defined(__GNUC__) && defined(__x86_64__)
-__attribute__((target("avx2"))) void shadeRowAvx2(int n, const float* gx, const float* gy,
-                                                  const float* hh, const float* rim,
-                                                  const float* bx, const float* by, float u0,
-                                                  float du, const RowCoefficients& k, float* out_b,
-                                                  float* out_g, float* out_r) {
+#if NORM2TEX_HAS_AVX2_BUILD
+NORM2TEX_TARGET_AVX2 void shadeRowAvx2(int n, const float* gx, const float* gy, const float* hh,
+                                       const float* rim, const float* bx, const float* by, float u0,
+                                       float du, const RowCoefficients& k, float* out_b,
+                                       float* out_g, float* out_r) {
   shadeRowBody(n, gx, gy, hh, rim, bx, by, u0, du, k, out_b, out_g, out_r);
 }
 #endif
 
-#if defined(__GNUC__) && defined(__x86_64__)
-bool hasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
-const ShadeRow shadeRow = hasAvx2() ? shadeRowAvx2 : shadeRowBaseline;
-const Differences differences = hasAvx2() ? differencesAvx2 : differencesBaseline;
+#if NORM2TEX_HAS_AVX2_BUILD
+const ShadeRow shadeRow = pickSimd<ShadeRow>(shadeRowAvx2, shadeRowBaseline);
+const Differences differences = pickSimd<Differences>(differencesAvx2, differencesBaseline);
 #else
 const ShadeRow shadeRow = shadeRowBaseline;
 const Differences differences = differencesBaseline;
