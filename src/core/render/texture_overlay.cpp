@@ -39,10 +39,14 @@ void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv:
   const cv::Rect box = raster.covered_box;
   // Per row: which pixels have the surface over them, H_local there (SIMD look-up), then
   // H_final. Reused per thread: the renderer calls this every frame.
-  thread_local std::vector<unsigned char> covered;
-  thread_local std::vector<float> heights;
-  covered.resize(box.width);
-  heights.resize(box.width);
+  thread_local std::vector<unsigned char> covered_buffer;
+  thread_local std::vector<float> heights_buffer;
+  covered_buffer.resize(box.width);
+  heights_buffer.resize(box.width);
+  // Plain pointers: through the thread_local vectors the compiler reloads their data on every
+  // byte written (a char may alias anything) and the loops stay scalar.
+  unsigned char* const covered = covered_buffer.data();
+  float* const heights = heights_buffer.data();
   for (int r = box.y; r < box.y + box.height; ++r) {
     const float* gap = raster.gap_mm.ptr<float>(r) + box.x;
     const cv::Vec2f* uv = raster.uv.ptr<cv::Vec2f>(r) + box.x;
@@ -51,11 +55,11 @@ void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv:
     // Branch-free, so the compiler vectorises both loops. The gap is finite or +infinity (no
     // surface over the pixel; the rasterizer never writes NaN), and -infinity clamps to 0.
     for (int i = 0; i < box.width; ++i) covered[i] = gap[i] < kNoSurface;
-    atlas_->sampleFiniteRow(uv, covered.data(), box.width, heights.data());
+    atlas_->sampleFiniteRow(uv, covered, box.width, heights);
     for (int i = 0; i < box.width; ++i) {
       out[i] = std::min(std::max(beta * heights[i] - gap[i], 0.0f), thickness);
     }
-    if (local != nullptr) std::copy_n(heights.data(), box.width, local);
+    if (local != nullptr) std::copy_n(heights, box.width, local);
   }
 }
 

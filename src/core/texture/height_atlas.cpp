@@ -4,10 +4,16 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/simd_dispatch.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
 
 namespace norm2tex {
@@ -21,6 +27,118 @@ cv::Mat_<T> owned(cv::Mat_<T> matrix) {
   return sole_owner ? matrix : cv::Mat_<T>(matrix.clone());
 }
 
+#if NORM2TEX_HAS_AVX2_BUILD
+/// a0 b0 a1 b1 a2 b2 a3 b3 | a4 b4 ... a7 b7 (as two vectors, low then high) -> a0 ... a7: the
+/// shuffle works within 128-bit halves, the permute puts the halves' pairs in order.
+NORM2TEX_TARGET_AVX2 inline __m256 deinterleaveEven(__m256 low, __m256 high) {
+  return _mm256_castpd_ps(_mm256_permute4x64_pd(
+      _mm256_castps_pd(_mm256_shuffle_ps(low, high, _MM_SHUFFLE(2, 0, 2, 0))), 0xd8));
+}
+/// ... -> b0 ... b7.
+NORM2TEX_TARGET_AVX2 inline __m256 deinterleaveOdd(__m256 low, __m256 high) {
+  return _mm256_castpd_ps(_mm256_permute4x64_pd(
+      _mm256_castps_pd(_mm256_shuffle_ps(low, high, _MM_SHUFFLE(3, 1, 3, 1))), 0xd8));
+}
+
+/// What the eight-lane look-up reads of an atlas.
+struct AtlasTexels {
+  const float* heights;
+  int heights_step;  // floats per row
+  const unsigned char* interior;
+  int interior_step;  // bytes per row
+  int cols, rows;
+  bool repeat;
+};
+
+/// HeightAtlas::sampleFiniteRow eight UVs a step, texels gathered: the same operations in the
+/// same order as sampleFinite(), so the same floats. Lanes whose four texels are not one
+/// island's interior neighbours are listed in `slow` (for sampleFinite); unwanted lanes get 0.
+/// Returns the number of UVs done (a multiple of 8).
+NORM2TEX_TARGET_AVX2 int sampleInteriorLanesAvx2(const AtlasTexels& atlas, const cv::Vec2f* uv,
+                                                 const unsigned char* wanted, int count, float* out,
+                                                 int* slow, int& slow_count) {
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  const __m256 half = _mm256_set1_ps(0.5f);
+  const __m256 cols = _mm256_set1_ps(static_cast<float>(atlas.cols));
+  const __m256 rows = _mm256_set1_ps(static_cast<float>(atlas.rows));
+  const __m256i last_x0 = _mm256_set1_epi32(atlas.cols - 2),
+                last_y0 = _mm256_set1_epi32(atlas.rows - 2);
+  const __m256i zero_int = _mm256_setzero_si256(), byte = _mm256_set1_epi32(0xff);
+  const __m256i heights_step = _mm256_set1_epi32(atlas.heights_step);
+  const __m256i interior_step = _mm256_set1_epi32(atlas.interior_step);
+  const float* below = atlas.heights + atlas.heights_step;
+  int i = 0;
+  for (; i + 8 <= count; i += 8) {
+    const __m256 first = _mm256_loadu_ps(reinterpret_cast<const float*>(uv + i));
+    const __m256 second = _mm256_loadu_ps(reinterpret_cast<const float*>(uv + i + 4));
+    __m256 u = deinterleaveEven(first, second), v = deinterleaveOdd(first, second);
+    if (atlas.repeat) {
+      u = _mm256_sub_ps(u, _mm256_floor_ps(u));
+      v = _mm256_sub_ps(v, _mm256_floor_ps(v));
+    } else {
+      u = _mm256_min_ps(_mm256_max_ps(u, zero), one);
+      v = _mm256_min_ps(_mm256_max_ps(v, zero), one);
+    }
+    const __m256 x = _mm256_sub_ps(_mm256_mul_ps(u, cols), half);
+    const __m256 y = _mm256_sub_ps(_mm256_mul_ps(_mm256_sub_ps(one, v), rows), half);
+    const __m256 x_floor = _mm256_floor_ps(x), y_floor = _mm256_floor_ps(y);
+    const __m256i x0 = _mm256_cvttps_epi32(x_floor), y0 = _mm256_cvttps_epi32(y_floor);
+    const __m256 fx = _mm256_sub_ps(x, x_floor), fy = _mm256_sub_ps(y, y_floor);
+    const __m256i want = _mm256_cmpgt_epi32(
+        _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(wanted + i))),
+        _mm256_setzero_si256());
+    // 0 <= x0 <= cols - 2 and 0 <= y0 <= rows - 2.
+    const __m256i inside = _mm256_andnot_si256(
+        _mm256_or_si256(
+            _mm256_or_si256(_mm256_cmpgt_epi32(zero_int, x0), _mm256_cmpgt_epi32(x0, last_x0)),
+            _mm256_or_si256(_mm256_cmpgt_epi32(zero_int, y0), _mm256_cmpgt_epi32(y0, last_y0))),
+        want);
+    // The interior flag: a byte, gathered as 32 bits (in bounds: a whole row follows it).
+    const __m256i flag_index = _mm256_add_epi32(_mm256_mullo_epi32(y0, interior_step), x0);
+    const __m256i flags =
+        _mm256_and_si256(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
+                                                     reinterpret_cast<const int*>(atlas.interior),
+                                                     flag_index, inside, 1),
+                         byte);
+    const __m256i fast =
+        _mm256_andnot_si256(_mm256_cmpeq_epi32(flags, _mm256_setzero_si256()), inside);
+    const __m256 fast_mask = _mm256_castsi256_ps(fast);
+    // Each lane's two neighbours in a row are one 64-bit load: four gathers of four pairs.
+    const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(y0, heights_step), x0);
+    const __m128i index_low = _mm256_castsi256_si128(index);
+    const __m128i index_high = _mm256_extracti128_si256(index, 1);
+    const __m256i mask_low = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(fast));
+    const __m256i mask_high = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(fast, 1));
+    const auto* top = reinterpret_cast<const long long*>(atlas.heights);
+    const auto* bottom = reinterpret_cast<const long long*>(below);
+    const __m256i none = _mm256_setzero_si256();
+    const __m256 top_low =
+        _mm256_castsi256_ps(_mm256_mask_i32gather_epi64(none, top, index_low, mask_low, 4));
+    const __m256 top_high =
+        _mm256_castsi256_ps(_mm256_mask_i32gather_epi64(none, top, index_high, mask_high, 4));
+    const __m256 bottom_low =
+        _mm256_castsi256_ps(_mm256_mask_i32gather_epi64(none, bottom, index_low, mask_low, 4));
+    const __m256 bottom_high =
+        _mm256_castsi256_ps(_mm256_mask_i32gather_epi64(none, bottom, index_high, mask_high, 4));
+    const __m256 t00 = deinterleaveEven(top_low, top_high);
+    const __m256 t01 = deinterleaveOdd(top_low, top_high);
+    const __m256 t10 = deinterleaveEven(bottom_low, bottom_high);
+    const __m256 t11 = deinterleaveOdd(bottom_low, bottom_high);
+    const __m256 gx = _mm256_sub_ps(one, fx), gy = _mm256_sub_ps(one, fy);
+    const __m256 result = _mm256_add_ps(
+        _mm256_mul_ps(gy, _mm256_add_ps(_mm256_mul_ps(gx, t00), _mm256_mul_ps(fx, t01))),
+        _mm256_mul_ps(fy, _mm256_add_ps(_mm256_mul_ps(gx, t10), _mm256_mul_ps(fx, t11))));
+    _mm256_storeu_ps(out + i, _mm256_and_ps(result, fast_mask));
+    unsigned pending = static_cast<unsigned>(
+        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_andnot_si256(fast, want))));
+    while (pending != 0) {
+      slow[slow_count++] = i + __builtin_ctz(pending);
+      pending &= pending - 1;
+    }
+  }
+  return i;
+}
+#endif
 }  // namespace
 
 HeightAtlas::HeightAtlas(cv::Mat1f heights, cv::Mat1b valid, UvWrap wrap)
@@ -109,6 +227,25 @@ void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* want
   alignas(16) float fx[4], fy[4];
   float t00[4], t01[4], t10[4], t11[4];
   int i = 0;
+#if NORM2TEX_HAS_AVX2_BUILD
+  static const bool avx2 = cpuHasAvx2();
+  if (avx2) {
+    const AtlasTexels texels{heights_.ptr<float>(),
+                             static_cast<int>(row_step),
+                             interior_.ptr<unsigned char>(),
+                             static_cast<int>(interior_.step1()),
+                             heights_.cols,
+                             heights_.rows,
+                             repeat};
+    thread_local std::vector<int> slow;
+    slow.resize(static_cast<std::size_t>(count));
+    int slow_count = 0;
+    i = sampleInteriorLanesAvx2(texels, uv, wanted, count, out, slow.data(), slow_count);
+    for (int k = 0; k < slow_count; ++k) {
+      out[slow[k]] = sampleFinite(uv[slow[k]][0], uv[slow[k]][1]);
+    }
+  }
+#endif
   for (; i + 4 <= count; i += 4) {
     v_float32x4 u, v;
     cv::v_load_deinterleave(reinterpret_cast<const float*>(uv + i), u, v);
