@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <sstream>
 
-#include <opencv2/core/utility.hpp>
 #include <ros/package.h>
+#include <opencv2/core/utility.hpp>
 
 #include "conversions.hpp"
 #include "norm2tex/common/error.hpp"
@@ -21,6 +21,11 @@ namespace {
 
 using ros_params::badParameter;
 using ros_params::packageFile;
+
+ros::NodeHandle onQueue(ros::NodeHandle nh, ros::CallbackQueue* queue) {
+  nh.setCallbackQueue(queue);
+  return nh;
+}
 
 }  // namespace
 
@@ -73,7 +78,8 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
   pnh.param("texture_from_frame", p.texture_from_frame, p.texture_from_frame);
   if (p.texture_from_frame && p.material.empty()) {
-    badParameter("texture_from_frame", "true", "false with ~normal_map or ~atlas (frames name materials)");
+    badParameter("texture_from_frame", "true",
+                 "false with ~normal_map or ~atlas (frames name materials)");
   }
   return p;
 }
@@ -82,8 +88,9 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
     : params_(readTactileRendererParams(private_nh)),
       nh_(nh),
       tf_buffer_(ros::Duration(30.0)),
+      // No thread of its own: the frames' thread inserts TF as it needs it (TransformWaiter).
       // No Nagle delay on the small TF and frame messages between separate nodes.
-      tf_listener_(tf_buffer_, nh, true, ros::TransportHints().tcpNoDelay()),
+      tf_listener_(tf_buffer_, onQueue(nh, &tf_queue_), false, ros::TransportHints().tcpNoDelay()),
       it_(nh) {
   keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   SensorModel model = loadSensorModel(params_.sensor);
@@ -161,12 +168,14 @@ void TactileRendererRos::useTexture(const TextureSource& source, const std::stri
   const double beta = params_.beta >= 0.0     ? params_.beta
                       : texture.beta_mm > 0.0 ? texture.beta_mm
                                               : 0.1;
-  const std::string warning = renderer_->setObject(mesh_, texture.atlas, texture.atlas ? beta : 0.0);
+  const std::string warning =
+      renderer_->setObject(mesh_, texture.atlas, texture.atlas ? beta : 0.0);
   if (!warning.empty()) ROS_WARN("%s: %s", params_.sensor_name.c_str(), warning.c_str());
   texture_key_ = key;
-  const char* origin = lookup.origin == ObjectTextureCache::Origin::kCached       ? "kept"
-                       : lookup.origin == ObjectTextureCache::Origin::kPrefetched ? "prepared in the background"
-                                                                                  : "prepared";
+  const char* origin = lookup.origin == ObjectTextureCache::Origin::kCached ? "kept"
+                       : lookup.origin == ObjectTextureCache::Origin::kPrefetched
+                           ? "prepared in the background"
+                           : "prepared";
   ROS_INFO("%s: %s, beta %.3f mm, %s, waited %.2f s", params_.sensor_name.c_str(),
            texture.atlas ? texture.description.c_str() : "no texture", texture.atlas ? beta : 0.0,
            origin, lookup.waited_s);
@@ -201,12 +210,10 @@ void TactileRendererRos::followFrameTexture(const SimFrame& frame) {
   // The background works on a copy: the renderer keeps reading its mesh meanwhile. Another
   // preparation under way: tried again with the next frame.
   std::shared_ptr<const TexturedMesh> mesh = mesh_;
-  prefetch_done_ = textures_.prefetch(next_key,
-                                      [source = prefetch_source_, mesh] {
-                                        TexturedMesh copy = *mesh;
-                                        return loadObjectTexture(source, copy);
-                                      }) ||
-                   textures_.contains(next_key);
+  prefetch_done_ = textures_.prefetch(next_key, [source = prefetch_source_, mesh] {
+    TexturedMesh copy = *mesh;
+    return loadObjectTexture(source, copy);
+  }) || textures_.contains(next_key);
 }
 
 bool TactileRendererRos::anyoneListens() const {
@@ -215,8 +222,12 @@ bool TactileRendererRos::anyoneListens() const {
 }
 
 void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
-  // Real time: skip the work when nobody listens. Synchronous: every frame is rendered.
-  if (!frame->acknowledge && !anyoneListens()) return;
+  // Real time: skip the work when nobody listens (but keep the TF queue short). Synchronous:
+  // every frame is rendered.
+  if (!frame->acknowledge && !anyoneListens()) {
+    tf_waiter_.insertReceived();
+    return;
+  }
   if (frame->acknowledge && answered_any_ && frame->frame <= last_answered_frame_) {
     // Offered again (a source re-offers frames it has no answer to from everyone): answer
     // again, never render twice; a frame older than the answers kept is ignored.

@@ -98,8 +98,10 @@ class TactileRendererRos {
 
   ros::NodeHandle nh_;
   tf2_ros::Buffer tf_buffer_;
+  /// TF messages, inserted into tf_buffer_ by the frames' thread itself (TransformWaiter).
+  ros::CallbackQueue tf_queue_;
   tf2_ros::TransformListener tf_listener_;
-  TransformWaiter tf_waiter_{tf_buffer_};
+  TransformWaiter tf_waiter_{tf_buffer_, tf_queue_};
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
   ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;

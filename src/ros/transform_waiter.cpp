@@ -19,7 +19,34 @@ TransformWaiter::TransformWaiter(tf2::BufferCore& buffer)
           [this](tf2::TransformableRequestHandle request, const std::string&, const std::string&,
                  ros::Time, tf2::TransformableResult) { onTransformable(request); })) {}
 
+TransformWaiter::TransformWaiter(tf2::BufferCore& buffer, ros::CallbackQueue& tf_queue)
+    : TransformWaiter(buffer) {
+  tf_queue_ = &tf_queue;
+}
+
 TransformWaiter::~TransformWaiter() { buffer_.removeTransformableCallback(callback_); }
+
+void TransformWaiter::insertReceived() {
+  if (tf_queue_ != nullptr) tf_queue_->callAvailable();
+}
+
+bool TransformWaiter::waitServingQueue(const std::string& target, const std::string& source,
+                                       const ros::Time& stamp, double timeout_s, std::string* why) {
+  tf_queue_->callAvailable();
+  if (buffer_.canTransform(target, source, stamp)) return true;
+  const std::chrono::steady_clock::time_point deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(std::max(0.0, timeout_s)));
+  for (auto now = std::chrono::steady_clock::now(); now < deadline;
+       now = std::chrono::steady_clock::now()) {
+    // Returns as soon as a message is queued (or after the wait): no polling interval.
+    const std::chrono::duration<double> left = deadline - now;
+    tf_queue_->callAvailable(ros::WallDuration(left.count()));
+    if (buffer_.canTransform(target, source, stamp)) return true;
+  }
+  return buffer_.canTransform(target, source, stamp, why);
+}
 
 void TransformWaiter::onTransformable(tf2::TransformableRequestHandle request) {
   {
@@ -31,6 +58,7 @@ void TransformWaiter::onTransformable(tf2::TransformableRequestHandle request) {
 
 bool TransformWaiter::wait(const std::string& target, const std::string& source,
                            const ros::Time& stamp, double timeout_s, std::string* why) {
+  if (tf_queue_ != nullptr) return waitServingQueue(target, source, stamp, timeout_s, why);
   if (buffer_.canTransform(target, source, stamp)) return true;
   const std::chrono::steady_clock::time_point deadline =
       std::chrono::steady_clock::now() +

@@ -1,9 +1,13 @@
 // TransformWaiter: a pose at an exact stamp, waited for without polling (no master needed).
+#include <atomic>
 #include <thread>
+
+#include <ros/callback_queue.h>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <tf2/buffer_core.h>
+#include <boost/make_shared.hpp>
 
 #include "transform_waiter.hpp"
 
@@ -63,6 +67,56 @@ TEST(TransformWaiterTest, NeverExtrapolatesAndGivesTheReasonAfterTheTimeout) {
   // A pose that arrives after a wait gave up does not confuse the next wait.
   buffer.setTransform(objectInGel(3.0, 2.0), "test");
   EXPECT_TRUE(waiter.wait("gel", "object", ros::Time(2.5), 0.0));
+}
+
+/// A TF message waiting in a TransformListener's queue: inserted by whoever serves the queue.
+class QueuedPose : public ros::CallbackInterface {
+ public:
+  QueuedPose(tf2::BufferCore& buffer, geometry_msgs::TransformStamped pose,
+             std::thread::id* inserted_by)
+      : buffer_(buffer), pose_(std::move(pose)), inserted_by_(inserted_by) {}
+  CallResult call() override {
+    buffer_.setTransform(pose_, "test");
+    if (inserted_by_ != nullptr) *inserted_by_ = std::this_thread::get_id();
+    return Success;
+  }
+
+ private:
+  tf2::BufferCore& buffer_;
+  geometry_msgs::TransformStamped pose_;
+  std::thread::id* inserted_by_;
+};
+
+TEST(TransformWaiterTest, WithItsQueueTheWaitingThreadInsertsThePosesItself) {
+  tf2::BufferCore buffer;
+  ros::CallbackQueue tf_queue;
+  TransformWaiter waiter(buffer, tf_queue);
+  std::thread::id inserted_by;
+  // Published before the frame: already queued when the frame is handled, no wait at all.
+  tf_queue.addCallback(boost::make_shared<QueuedPose>(buffer, objectInGel(1.0, 0.0), nullptr));
+  tf_queue.addCallback(boost::make_shared<QueuedPose>(buffer, objectInGel(2.0, 1.0), &inserted_by));
+  EXPECT_TRUE(waiter.wait("gel", "object", ros::Time(1.5), 0.0));
+  EXPECT_EQ(inserted_by, std::this_thread::get_id()) << "inserted on the waiting thread";
+  // Arriving later (a TF message on the wire): the wait returns once it is queued.
+  for (int frame = 3; frame <= 5; ++frame) {
+    std::thread transport([&, frame] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the message is late
+      tf_queue.addCallback(
+          boost::make_shared<QueuedPose>(buffer, objectInGel(frame, frame), &inserted_by));
+    });
+    EXPECT_TRUE(waiter.wait("gel", "object", ros::Time(frame), 30.0)) << "frame " << frame;
+    EXPECT_EQ(inserted_by, std::this_thread::get_id());
+    transport.join();
+  }
+  // Never extrapolated: past the last pose it times out with tf2's reason.
+  std::string why;
+  EXPECT_FALSE(waiter.wait("gel", "object", ros::Time(5.5), 0.05, &why));
+  EXPECT_NE(why.find("extrapolation"), std::string::npos) << why;
+  // insertReceived() empties the queue without waiting.
+  tf_queue.addCallback(boost::make_shared<QueuedPose>(buffer, objectInGel(6.0, 6.0), nullptr));
+  waiter.insertReceived();
+  EXPECT_TRUE(tf_queue.empty());
+  EXPECT_TRUE(buffer.canTransform("gel", "object", ros::Time(5.5)));
 }
 
 }  // namespace
