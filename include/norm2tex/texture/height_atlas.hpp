@@ -79,6 +79,12 @@ class HeightAtlas {
   void sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
                        float* out) const;
 
+  /// Asks the CPU to start loading what sampleFiniteRow() reads at these UVs (every 8th one:
+  /// neighbours share cache lines), without waiting. The overlay calls it a row ahead: a frame
+  /// reads ~0.4 MB of an atlas scattered over 4+ MB, and with the texels still in memory each
+  /// gather waits for them (the look-up took 425 instead of 252 us at 60 Hz).
+  void prefetchRow(const cv::Vec2f* uv, int count) const;
+
   bool empty() const { return heights_.empty(); }
   int rows() const { return heights_.rows; }
   int cols() const { return heights_.cols; }

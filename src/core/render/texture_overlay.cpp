@@ -54,6 +54,10 @@ void TextureOverlay::apply(const ContactRaster& raster, double thickness_mm, cv:
     float* local = h_local != nullptr ? h_local->ptr<float>(r) + box.x : nullptr;
     // Branch-free, so the compiler vectorises both loops. The gap is finite or +infinity (no
     // surface over the pixel; the rasterizer never writes NaN), and -infinity clamps to 0.
+    // The next row's texels start loading while this row is sampled.
+    if (r + 1 < box.y + box.height) {
+      atlas_->prefetchRow(raster.uv.ptr<cv::Vec2f>(r + 1) + box.x, box.width);
+    }
     for (int i = 0; i < box.width; ++i) covered[i] = gap[i] < kNoSurface;
     atlas_->sampleFiniteRow(uv, covered, box.width, heights);
     for (int i = 0; i < box.width; ++i) {

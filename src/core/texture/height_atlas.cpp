@@ -294,6 +294,25 @@ void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* want
   for (; i < count; ++i) out[i] = wanted[i] ? sampleFinite(uv[i][0], uv[i][1]) : 0.0f;
 }
 
+void HeightAtlas::prefetchRow(const cv::Vec2f* uv, int count) const {
+  if (heights_.cols < 2 || heights_.rows < 2) return;  // nothing worth it, and no clamp range
+  const bool repeat = wrap_ == UvWrap::kRepeat;
+  for (int i = 0; i < count; i += 8) {
+    float u = uv[i][0], v = uv[i][1];
+    if (!std::isfinite(u) || !std::isfinite(v)) continue;
+    if (repeat) {
+      u -= std::floor(u);
+      v -= std::floor(v);
+    }
+    const int x0 = std::clamp(static_cast<int>(u * heights_.cols), 0, heights_.cols - 2);
+    const int y0 = std::clamp(static_cast<int>((1.0f - v) * heights_.rows), 0, heights_.rows - 2);
+    const float* top = heights_.ptr<float>(y0) + x0;
+    __builtin_prefetch(top);
+    __builtin_prefetch(top + heights_.step1());
+    __builtin_prefetch(interior_.ptr<unsigned char>(y0) + x0);
+  }
+}
+
 float HeightAtlas::sampleAcrossBorder(int x0, int y0, float fx, float fy, bool* valid) const {
   if (valid != nullptr) *valid = false;
   const int cols[2] = {wrapIndex(x0, heights_.cols), wrapIndex(x0 + 1, heights_.cols)};
