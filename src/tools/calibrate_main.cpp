@@ -176,8 +176,9 @@ void warnAboutFittedScale(const norm2tex::ShadingFit& fit) {
     std::fprintf(stderr,
                  "norm2tex_calibrate: warning: the fitted scale (%.4f mm/px) is at the end of the "
                  "searched range: the presses do not pin it down (a response fitted to your unit "
-                 "absorbs most of a change of scale, and real presses fit best at the smallest "
-                 "scale); measure it (a ruler pressed into the gel) and pass --mm-per-pixel\n",
+                 "absorbs most of a change of scale, and a real DIGIT's presses fitted best at the "
+                 "smallest scale); measure it (a ruler pressed into the gel) and pass "
+                 "--mm-per-pixel\n",
                  fit.geometry.mm_per_pixel);
   } else if (!search.profile.empty() && search.range_max > 1.1 * search.range_min) {
     std::fprintf(stderr,

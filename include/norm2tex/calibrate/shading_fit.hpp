@@ -56,8 +56,8 @@ constexpr double kScaleIndifference = 0.01;
 /// in pixels a ball's slopes depend on the scale through the ball radius in pixels alone, to
 /// first order as one factor that the fitted response absorbs; what is left (the sphere's
 /// departure from a paraboloid, the gel blurs' widths in mm) is of the size of the response
-/// model's own error. A response unlike the fitted one (the analytic LEDs, rendered at 0.054)
-/// and real DIGIT presses both fit best at the smallest scale searched.
+/// model's own error. Presses with a response unlike the fitted one (the analytic LEDs, rendered
+/// at 0.054) and the real s09 presses (0.0532) both fit best at the smallest scale searched.
 struct ScaleSearch {
   std::vector<ScaleProfilePoint> profile;   ///< the coarse grid, by increasing scale
   double range_min = 0.0, range_max = 0.0;  ///< scales of the profile within kScaleIndifference
