@@ -19,8 +19,8 @@
 #include "norm2tex/calibrate/calibration_report.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include "norm2tex/common/error.hpp"
-#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/common/image_io.hpp"
+#include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 
 namespace {
@@ -40,7 +40,8 @@ constexpr const char* kUsage =
     "          at different places (at least 4; 10-50 recommended), portrait as your driver\n"
     "          publishes them.\n"
     "  --ball-diameter-mm: the pressing ball's diameter.\n"
-    "  --mm-per-pixel: the scale, if you know it; otherwise it is fitted.\n"
+    "  --mm-per-pixel: the scale, if you know it (recommended); otherwise it is fitted, but\n"
+    "          ball presses pin it only weakly (the range that fits as well is printed).\n"
     "  --labels: CSV lines 'file,centre_x_px,centre_y_px,radius_px' (file: as given or its base\n"
     "          name) for presses whose contact circle you know; the others are detected.\n"
     "  --size WxH: resample every frame to this size first (e.g. 240x320 for VGA captures of a\n"
@@ -167,6 +168,26 @@ std::vector<std::optional<norm2tex::PressCircle>> loadLabels(
   return labels;
 }
 
+// Ball presses pin the scale only weakly (ScaleSearch): say so when the fit ran to an end of the
+// searched range or scales far apart fit as well.
+void warnAboutFittedScale(const norm2tex::ShadingFit& fit) {
+  const norm2tex::ScaleSearch& search = fit.scale_search;
+  if (fit.scale_at_search_bound) {
+    std::fprintf(stderr,
+                 "norm2tex_calibrate: warning: the fitted scale (%.4f mm/px) is at the end of the "
+                 "searched range: the presses do not pin it down (a response fitted to your unit "
+                 "absorbs most of a change of scale, and a real DIGIT's presses fitted best at the "
+                 "smallest scale); measure it (a ruler pressed into the gel) and pass "
+                 "--mm-per-pixel\n",
+                 fit.geometry.mm_per_pixel);
+  } else if (!search.profile.empty() && search.range_max > 1.1 * search.range_min) {
+    std::fprintf(stderr,
+                 "norm2tex_calibrate: warning: scales from %.4f to %.4f mm/px fit the presses "
+                 "about as well; if you know yours, pass --mm-per-pixel\n",
+                 search.range_min, search.range_max);
+  }
+}
+
 int run(int argc, char** argv) {
   // The fit renders thousands of presses through frame-sized temporaries: reused, not faulted
   // in afresh each time (~3x faster calibration).
@@ -231,13 +252,10 @@ int run(int argc, char** argv) {
   for (const std::string& line : norm2tex::describeFitQuality(result)) {
     std::printf("  %s\n", line.c_str());
   }
-  if (result.fit.scale_at_search_bound) {
-    std::fprintf(stderr,
-                 "norm2tex_calibrate: warning: the fitted scale (%.4f mm/px) is at the end of the "
-                 "searched range: the presses do not pin it down; measure it (a ruler pressed "
-                 "into the gel) and pass --mm-per-pixel\n",
-                 result.fit.geometry.mm_per_pixel);
+  for (const std::string& line : norm2tex::describeScaleSearch(result.fit)) {
+    std::printf("  %s\n", line.c_str());
   }
+  warnAboutFittedScale(result.fit);
   return 0;
 }
 

@@ -3,6 +3,7 @@
 // DIGIT, and bad input.
 #include <malloc.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -155,6 +156,12 @@ TEST(Calibration, RoundTripRecoversTheScaleAndReproducesHeldOutPresses) {
   EXPECT_GE(result.held_out.presses, 3);
   EXPECT_EQ(result.training_presses + result.held_out.presses, 14);
   EXPECT_FALSE(result.fit.scale_at_search_bound);
+  // The profile of the search brackets the truth: here the response model is the renderer's own.
+  for (const std::string& line : describeScaleSearch(result.fit)) std::printf("%s\n", line.c_str());
+  const ScaleSearch& search = result.fit.scale_search;
+  EXPECT_GE(search.profile.size(), 8u);
+  EXPECT_LE(search.range_min, truth.mm_per_pixel);
+  EXPECT_GE(search.range_max, truth.mm_per_pixel);
 }
 
 NamedFrame fixtureFrame(int index) {
@@ -189,6 +196,34 @@ TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
   EXPECT_GT(q.real_contact_mean, 15.0);
   EXPECT_NEAR(q.real_side_deg[0], 70.0, 30.0);   // blue below
   EXPECT_NEAR(q.real_side_deg[2], -41.0, 30.0);  // red upper right
+}
+
+// Without the scale, the real presses do not pin it (ScaleSearch: a response fitted per unit
+// absorbs most of a change of scale, and real presses fit best at the smallest scale searched,
+// as presses rendered with the analytic LEDs do). The calibration must say so: the fit is
+// flagged at the bound, and its profile shows the source's own scale fitting nearly as well.
+TEST(Calibration, RealPressesWithoutTheScaleAreFlaggedAsNotPinningIt) {
+  CalibrationInput input;
+  input.backgrounds.push_back(fixtureFrame(30));
+  for (int i = 0; i <= 28; i += 2) input.presses.push_back(fixtureFrame(i));
+  input.ball_diameter_mm = 6.0;
+  const CalibrationResult result = calibrateSensor(makeDigitSensorModel(), input);
+  for (const std::string& line : describeScaleSearch(result.fit)) std::printf("%s\n", line.c_str());
+  EXPECT_TRUE(result.fit.scale_at_search_bound) << result.model.mm_per_pixel;
+  const ScaleSearch& search = result.fit.scale_search;
+  ASSERT_GE(search.profile.size(), 6u);
+  EXPECT_NEAR(search.range_min, kMinSearchedScale, 1e-9);
+  double best = 0.0, at_source_scale = 0.0, nearest = 1e9;
+  for (const ScaleProfilePoint& point : search.profile) {
+    best = std::max(best, point.variance_explained);
+    if (std::abs(point.mm_per_pixel - 0.0532) < nearest) {
+      nearest = std::abs(point.mm_per_pixel - 0.0532);
+      at_source_scale = point.variance_explained;
+    }
+  }
+  EXPECT_LT(nearest, 0.004);
+  EXPECT_GT(at_source_scale, best - 0.03) << "flat: the source's 0.0532 mm/px fits nearly as well";
+  EXPECT_GE(result.held_out.variance_explained, 0.5);
 }
 
 TEST(Calibration, BadInputIsAClearError) {

@@ -18,4 +18,8 @@ cv::Mat3b makeCalibrationReport(const CalibrationResult& result, int max_presses
 /// The held-out fit figures as lines of text (for the report image and the tool's output).
 std::vector<std::string> describeFitQuality(const CalibrationResult& result);
 
+/// When the scale was searched: how well each scale of the coarse grid fits, and the range of
+/// those within kScaleIndifference of the best, as lines of text; empty otherwise.
+std::vector<std::string> describeScaleSearch(const ShadingFit& fit);
+
 }  // namespace norm2tex

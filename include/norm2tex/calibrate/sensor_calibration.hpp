@@ -38,7 +38,7 @@ struct CalibrationOptions {
 struct CalibrationResult {
   SensorModel model;     ///< base + fitted scale, shading and noise; background_image unset
   cv::Mat3b background;  ///< mean of the no-contact frames
-  ShadingFit fit;        ///< on the training presses
+  ShadingFit fit;        ///< on the training presses (scale_search: the first fit's)
   FitQuality held_out;   ///< simulated vs real on the held-out presses
   std::vector<PressObservation> held_out_presses;
   std::vector<cv::Mat3f> held_out_simulated;  ///< the model's shading difference per press

@@ -40,12 +40,36 @@ constexpr double kFitRegionRadii = 2.0;
 constexpr double kMinSearchedScale = 0.03;
 constexpr double kMaxSearchedScale = 0.1;
 
+/// The fit at one scale of the coarse search grid: the best radius factor there, at the default
+/// rim-shadow width, on the presses as given to the search (detected circles).
+struct ScaleProfilePoint {
+  double mm_per_pixel = 0.0;
+  double radius_factor = 1.0;
+  double variance_explained = 0.0;
+};
+
+/// Scales whose fit explains within this share of the pixel variance of the best one are not
+/// told apart by the presses: the margin by which a wider rim shadow is judged "barely better".
+constexpr double kScaleIndifference = 0.01;
+
+/// How sharply the presses pick the scale, when it was searched. Ball presses pin it only weakly:
+/// in pixels a ball's slopes depend on the scale through the ball radius in pixels alone, to
+/// first order as one factor that the fitted response absorbs; what is left (the sphere's
+/// departure from a paraboloid, the gel blurs' widths in mm) is of the size of the response
+/// model's own error. Presses with a response unlike the fitted one (the analytic LEDs, rendered
+/// at 0.054) and the real s09 presses (0.0532) both fit best at the smallest scale searched.
+struct ScaleSearch {
+  std::vector<ScaleProfilePoint> profile;   ///< the coarse grid, by increasing scale
+  double range_min = 0.0, range_max = 0.0;  ///< scales of the profile within kScaleIndifference
+};
+
 /// A least-squares fit of the calibrated response to presses.
 struct ShadingFit {
   ShadingOptions shading;              ///< response fitted; gain 1; shadow_sigma_mm as used
   PressGeometry geometry;              ///< as used
   GelOptions gel;                      ///< the gel smoothing used (base's; not fitted)
   bool scale_at_search_bound = false;  ///< the fitted scale is an end of the searched range
+  ScaleSearch scale_search;            ///< empty unless the scale was searched on a coarse grid
   double variance_explained = 0.0;     ///< on the fitted presses, pixels of kFitRegionRadii
 };
 
@@ -62,7 +86,8 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
 /// ball.
 /// When the scale is searched and there are more than 16 presses, the search runs on 16 of
 /// them spread evenly over the set, and the response is then fitted on all.
-/// With `start`, the coarse grid is skipped and the local search starts there (a refit).
+/// With `start`, the coarse grid is skipped and the local search starts there (a refit);
+/// otherwise, when the scale is searched, `scale_search` holds the grid's profile.
 ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  const std::vector<PressObservation>& presses,
                                  double ball_radius_mm, std::optional<double> mm_per_pixel,

@@ -52,6 +52,29 @@ std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
   };
 }
 
+std::vector<std::string> describeScaleSearch(const ShadingFit& fit) {
+  const ScaleSearch& search = fit.scale_search;
+  if (search.profile.empty()) return {};
+  std::vector<std::string> lines = {
+      "scale searched (mm/px: variance explained, radius factor; detected circles):"};
+  // Three grid points a line keeps the lines short enough for a terminal.
+  for (size_t i = 0; i < search.profile.size(); i += 3) {
+    std::string line = " ";
+    for (size_t j = i; j < std::min(i + 3, search.profile.size()); ++j) {
+      const ScaleProfilePoint& p = search.profile[j];
+      line += format("  %.4f: %.3f, %.2f", p.mm_per_pixel, p.variance_explained, p.radius_factor);
+    }
+    lines.push_back(line);
+  }
+  // Only the spread under this response model: a real unit's response differs from it, and that
+  // can move the best scale further (ScaleSearch).
+  lines.push_back(
+      format("scales within %.2f of the best: %.4f-%.4f mm/px (fit about as well; a "
+             "response unlike the model's can move the best further)",
+             kScaleIndifference, search.range_min, search.range_max));
+  return lines;
+}
+
 cv::Mat3b makeCalibrationReport(const CalibrationResult& result, int max_presses) {
   const int rows = std::min<int>(max_presses, static_cast<int>(result.held_out_presses.size()));
   if (rows <= 0) throw Error("makeCalibrationReport: no held-out presses to show");

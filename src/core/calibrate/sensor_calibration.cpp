@@ -141,6 +141,9 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   // The refined circles carry the first radius factor: the refit starts from factor 1.
   result.fit = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel,
                                      PressGeometry{first.geometry.mm_per_pixel, 1.0});
+  // The scale profile is the first fit's, on the detected circles: the refined ones were fitted
+  // at the first scale and would favour it.
+  result.fit.scale_search = first.scale_search;
   result.training_presses = static_cast<int>(training.size());
 
   result.model = base;

@@ -106,6 +106,27 @@ ShadingFit solve(const NormalEquations& eq, const PressGeometry& geometry, doubl
   return fit;
 }
 
+// The grid points the ball could make (others were never fitted), and the range of scales
+// whose fit is within kScaleIndifference of the best.
+ScaleSearch summariseScaleSearch(std::vector<ScaleProfilePoint> grid) {
+  ScaleSearch search;
+  for (const ScaleProfilePoint& point : grid) {
+    if (point.mm_per_pixel > 0.0) search.profile.push_back(point);
+  }
+  if (search.profile.empty()) return search;
+  double best = -1e300;
+  for (const ScaleProfilePoint& point : search.profile) {
+    best = std::max(best, point.variance_explained);
+  }
+  search.range_min = 1e300;
+  for (const ScaleProfilePoint& point : search.profile) {
+    if (point.variance_explained < best - kScaleIndifference) continue;
+    search.range_min = std::min(search.range_min, point.mm_per_pixel);
+    search.range_max = std::max(search.range_max, point.mm_per_pixel);
+  }
+  return search;
+}
+
 }  // namespace
 
 cv::Mat1f simulatedPressGel(const SensorModel& base, const PressCircle& circle,
@@ -183,30 +204,48 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   }
   const std::vector<PressObservation>& search = use_subset ? subset : presses;
   SensorModel model = base;
-  const auto tryGeometry = [&](PressGeometry g, double sigma) {
+  // The fit at `g` (clamped to the searched ranges), or nothing where the ball cannot make it.
+  const auto fitAt = [&](PressGeometry g, double sigma) -> std::optional<ShadingFit> {
     g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
     if (mm_per_pixel) g.mm_per_pixel = *mm_per_pixel;
     g.mm_per_pixel =
         std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
-    if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) return false;
-    const ShadingFit fit = fitShadingResponse(model, search, g, ball_radius_mm, sigma);
-    if (fit.variance_explained <= best.variance_explained) return false;
-    best = fit;
+    if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) {
+      return std::nullopt;
+    }
+    return fitShadingResponse(model, search, g, ball_radius_mm, sigma);
+  };
+  const auto keepIfBetter = [&](const std::optional<ShadingFit>& fit) {
+    if (!fit || fit->variance_explained <= best.variance_explained) return false;
+    best = *fit;
     return true;
   };
+  const auto tryGeometry = [&](PressGeometry g, double sigma) {
+    return keepIfBetter(fitAt(g, sigma));
+  };
 
-  // Coarse grid: factor in steps of 0.1, scale log-spaced (12 steps over the range).
+  // Coarse grid: factor in steps of 0.1, scale log-spaced (12 steps over the range). When the
+  // scale is searched, the best fit at each grid scale is its profile.
   constexpr int kScaleSteps = 12;
   const double scale_ratio = std::pow(scale_hi / scale_lo, 1.0 / (kScaleSteps - 1));
+  std::vector<ScaleProfilePoint> profile(kScaleSteps);
   if (start) tryGeometry(*start, default_sigma);
   for (double factor = factor_lo; !start && factor <= factor_hi + 1e-9; factor += 0.1) {
     const double top = std::min(scale_hi, feasibleScale(factor));
     for (int i = 0; i < (mm_per_pixel ? 1 : kScaleSteps); ++i) {
       const double scale = scale_lo * std::pow(scale_ratio, i);
       if (!mm_per_pixel && scale > top) break;
-      tryGeometry({scale, factor}, default_sigma);
+      const std::optional<ShadingFit> fit = fitAt({scale, factor}, default_sigma);
+      keepIfBetter(fit);
+      if (fit && (profile[i].mm_per_pixel == 0.0 ||
+                  fit->variance_explained > profile[i].variance_explained)) {
+        profile[i] = {fit->geometry.mm_per_pixel, fit->geometry.radius_factor,
+                      fit->variance_explained};
+      }
     }
   }
+  const ScaleSearch scale_search =
+      (start || mm_per_pixel) ? ScaleSearch{} : summariseScaleSearch(std::move(profile));
   // Local pattern search around the best, halving the steps when nothing improves.
   double scale_step = start ? std::sqrt(scale_ratio) : scale_ratio;
   double factor_step = start ? 0.025 : 0.05;
@@ -263,6 +302,7 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
                               best.shading.shadow_sigma_mm);
     best.scale_at_search_bound = at_bound;
   }
+  best.scale_search = scale_search;
   return best;
 }
 
