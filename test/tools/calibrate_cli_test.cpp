@@ -1,6 +1,7 @@
 // Runs the real norm2tex_calibrate executable on presses rendered with a known sensor: the yaml
 // it writes loads and carries the fit, the background and report are written, labels are used,
-// and bad input is a one-line error (exit 1) or the usage (exit 2).
+// a fitted scale comes with its profile, and bad input is a one-line error (exit 1) or the usage
+// (exit 2).
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -86,6 +87,21 @@ TEST_F(CalibrateCli, WritesASensorYamlThatLoadsWithItsBackgroundAndAReport) {
   const cv::Mat report = cv::imread(path("report.png"));
   EXPECT_EQ(report.cols, 3 * 160);
   EXPECT_GT(report.rows, 160);
+}
+
+// Without --mm-per-pixel the scale is fitted, and since ball presses pin it only weakly the
+// tool prints how well each searched scale fits and the range that fits about as well.
+TEST_F(CalibrateCli, WithoutTheScaleItPrintsHowWellEachScaleFits) {
+  const CliRun run = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                               " --ball-diameter-mm 6 --labels " + path("labels.csv") + " -o " +
+                               path("fitted.yaml"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("scale searched (mm/px: variance explained"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("scales within 0.01 of the best"), std::string::npos) << run.output;
+  const norm2tex::SensorModel model = norm2tex::loadSensorModel(path("fitted.yaml"));
+  EXPECT_GE(model.mm_per_pixel, 0.03);
+  EXPECT_LE(model.mm_per_pixel, 0.1);
 }
 
 TEST_F(CalibrateCli, LabelsReplaceDetection) {
