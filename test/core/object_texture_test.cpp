@@ -344,6 +344,16 @@ TEST(MemoryReuse, FreedTextureSizedBlocksStayInTheHeapForTheNextOne) {
   EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "the block was mapped, not taken from the heap";
   std::free(block);
   EXPECT_GE(mallinfo2().fordblks, size) << "the freed block went back to the kernel";
+  // A 2048^2 texture's 16-bit BGRA normal map is 32 MB: at glibc's largest mmap threshold, so
+  // it must not be mapped either.
+  const std::size_t large = 32u << 20;
+  void* big = std::malloc(large);
+  ASSERT_NE(big, nullptr);
+  std::memset(big, 1, large);
+  EXPECT_EQ(mallinfo2().hblkhd, mapped_before)
+      << "the 32 MB block was mapped, not taken from the heap";
+  std::free(big);
+  EXPECT_GE(mallinfo2().fordblks, large) << "the freed 32 MB block went back to the kernel";
 }
 
 }  // namespace
