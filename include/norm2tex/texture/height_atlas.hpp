@@ -72,10 +72,11 @@ class HeightAtlas {
     return sampleAcrossBorder(x0, y0, fx, fy, valid);
   }
 
-  /// sampleFinite() at `count` UVs (finite, as there), four at a time: out[i] is bit for bit
+  /// sampleFinite() at `count` UVs (finite, as there): out[i] is bit for bit
   /// sampleFinite(uv[i]) where wanted[i] != 0, and 0 where it is 0 (not looked up). The
-  /// overlay's per-row look-up for a whole contact: the arithmetic runs in SIMD lanes, only the
-  /// texel loads stay scalar. Needs a non-empty atlas.
+  /// overlay's per-row look-up for a whole contact: eight UVs a step with gathered texel pairs
+  /// where the CPU has AVX2, else four with the arithmetic in SIMD lanes and scalar texel loads;
+  /// look-ups across an island's border go one at a time. Needs a non-empty atlas.
   void sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
                        float* out) const;
 
