@@ -1,8 +1,10 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "norm2tex/common/error.hpp"
@@ -88,6 +90,88 @@ TEST(NormalMap, SixteenBitIsFinerThanEightBit) {
   }
   EXPECT_LT(error16, error8 / 50.0);
   EXPECT_LT(error8, 0.05);
+}
+
+/// encodeNormalMapFromHeight's definition written out texel by texel, as it was first
+/// implemented: central differences inside the mask, one-sided at its edges, std::round.
+cv::Mat referenceFromHeight(const cv::Mat1f& h, const cv::Mat1b& mask, int depth, float y_sign) {
+  const double full = depth == CV_8U ? 255.0 : 65535.0;
+  const auto inside = [&](int r, int c) {
+    return r >= 0 && c >= 0 && r < h.rows && c < h.cols && mask(r, c) != 0;
+  };
+  const auto slope = [&](int r, int c, int dr, int dc) {
+    const bool f = inside(r + dr, c + dc), b = inside(r - dr, c - dc);
+    if (f && b) return 0.5f * (h(r + dr, c + dc) - h(r - dr, c - dc));
+    if (f) return h(r + dr, c + dc) - h(r, c);
+    if (b) return h(r, c) - h(r - dr, c - dc);
+    return 0.0f;
+  };
+  cv::Mat out(h.size(), CV_MAKETYPE(depth, 3));
+  for (int r = 0; r < h.rows; ++r) {
+    for (int c = 0; c < h.cols; ++c) {
+      float x = 0.0f, y = 0.0f, z = 1.0f;
+      if (inside(r, c)) {
+        const float gx = slope(r, c, 0, 1), gy = slope(r, c, 1, 0);
+        const float length = std::sqrt(gx * gx + gy * gy + 1.0f);
+        x = -gx / length;
+        y = -gy / length;
+        z = 1.0f / length;
+      }
+      const float components[3] = {z, y_sign * y, x};
+      for (int k = 0; k < 3; ++k) {
+        const double v = std::round((components[k] + 1.0) * 0.5 * full);
+        if (depth == CV_8U) {
+          out.at<cv::Vec3b>(r, c)[k] = cv::saturate_cast<uchar>(v);
+        } else {
+          out.at<cv::Vec3w>(r, c)[k] = cv::saturate_cast<ushort>(v);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+TEST(NormalEncoding, FromHeightEqualsTheTexelByTexelDefinitionBitForBit) {
+  cv::Mat1f height(37, 53);
+  cv::randu(height, -4.0f, 4.0f);
+  height(5, 7) = 0.0f;  // a few exact values: flat neighbourhoods quantise to exact halves
+  cv::Mat1b mask(height.size(), uchar(255));
+  cv::Mat1b holes(height.size());
+  cv::randu(holes, 0, 4);
+  mask.setTo(0, holes == 0);  // ~25 % masked: many one-sided and isolated texels
+  mask.row(0).setTo(0);
+  for (const int depth : {CV_8U, CV_16U}) {
+    for (const NormalConvention convention :
+         {NormalConvention::kOpenGL, NormalConvention::kDirectX}) {
+      const float y_sign = convention == NormalConvention::kOpenGL ? -1.0f : 1.0f;
+      const cv::Mat expected = referenceFromHeight(height, mask, depth, y_sign);
+      const cv::Mat encoded = encodeNormalMapFromHeight(height, convention, depth, mask);
+      ASSERT_EQ(encoded.type(), expected.type());
+      EXPECT_EQ(cv::norm(encoded, expected, cv::NORM_INF), 0.0) << "depth " << depth;
+      const cv::Mat1b everywhere(height.size(), uchar(255));
+      EXPECT_EQ(cv::norm(encodeNormalMapFromHeight(height, convention, depth),
+                         referenceFromHeight(height, everywhere, depth, y_sign), cv::NORM_INF),
+                0.0)
+          << "no mask = every texel valid";
+
+      // With alpha: the same colours, alpha full scale on the mask and 0 off it.
+      const cv::Mat bgra = encodeNormalMapFromHeight(height, convention, depth, mask, true);
+      ASSERT_EQ(bgra.channels(), 4);
+      std::vector<cv::Mat> channels;
+      cv::split(bgra, channels);
+      cv::Mat bgr;
+      cv::merge(std::vector<cv::Mat>{channels[0], channels[1], channels[2]}, bgr);
+      EXPECT_EQ(cv::norm(bgr, expected, cv::NORM_INF), 0.0);
+      cv::Mat expected_alpha;
+      mask.convertTo(expected_alpha, depth, depth == CV_8U ? 1.0 : 257.0);
+      EXPECT_EQ(cv::norm(channels[3], expected_alpha, cv::NORM_INF), 0.0);
+    }
+  }
+  test::expectError(
+      [&] {
+        encodeNormalMapFromHeight(height, NormalConvention::kOpenGL, CV_16U, cv::Mat1b(3, 3));
+      },
+      {"mask", "size"});
 }
 
 TEST(NormalMap, AlphaIsTheValidityMask) {
@@ -190,7 +274,8 @@ TEST(NormalMapErrors, TruncatedFilesAreRefusedNotDecodedAsGrey) {
   for (const std::string name : {"map.png", "map.jpg", "map.tif"}) {
     ASSERT_TRUE(cv::imwrite(dir.path(name), image));
     std::ifstream file(dir.path(name), std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    const std::string bytes((std::istreambuf_iterator<char>(file)),
+                            std::istreambuf_iterator<char>());
     EXPECT_NO_THROW(NormalMap::load(dir.path(name))) << name;
     for (const size_t cut : {size_t(200), bytes.size() / 2, bytes.size() - 40}) {
       const std::string truncated = dir.path("cut_" + std::to_string(cut) + "_" + name);

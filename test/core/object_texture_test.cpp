@@ -1,10 +1,12 @@
 // Where an object's texture comes from: a mesh's own normal texture, embedded in a GLB or a
 // file next to it, and what happens when it cannot be used.
 #include <malloc.h>
+#include <sys/resource.h>
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -354,6 +356,51 @@ TEST(MemoryReuse, FreedTextureSizedBlocksStayInTheHeapForTheNextOne) {
       << "the 32 MB block was mapped, not taken from the heap";
   std::free(big);
   EXPECT_GE(mallinfo2().fordblks, large) << "the freed 32 MB block went back to the kernel";
+}
+
+}  // namespace
+}  // namespace norm2tex
+
+namespace norm2tex {
+namespace {
+
+long threadPageFaults() {
+  rusage usage{};
+  getrusage(RUSAGE_THREAD, &usage);
+  return usage.ru_minflt;
+}
+
+bool transparentHugePagesOff() {
+  std::ifstream file("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  std::getline(file, modes);
+  return !file || modes.find("[never]") != std::string::npos;
+}
+
+TEST(MemoryReuse, ATexturePreparedOnAFreshThreadFaultsInFewPages) {
+  // The recorder prepares each variant's texture on a new thread. A thread's heaps beyond its
+  // first 64 MB are unmapped whenever they empty, so the buffers of a 2048^2 preparation
+  // (~220 MB) would be faulted in again in 4 KB pages (~13 us each on our VMs) for every variant.
+  if (transparentHugePagesOff()) {
+    GTEST_SKIP() << "transparent huge pages are off on this machine: the texture buffers use "
+                    "4 KB pages here, and this test cannot tell";
+  }
+  ASSERT_TRUE(keepFreedMemoryForReuse());
+  const auto mesh =
+      std::make_shared<const TexturedMesh>(makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02));
+  const auto prepare = [mesh] {
+    TextureSource source;
+    source.material_config = std::string(NORM2TEX_SOURCE_DIR) + "/config/materials/print3d.yaml";
+    TexturedMesh copy = *mesh;
+    const long before = threadPageFaults();
+    const ObjectTexture texture = loadObjectTexture(source, copy);
+    EXPECT_NE(texture.atlas, nullptr);
+    return threadPageFaults() - before;
+  };
+  std::async(std::launch::async, prepare).get();  // loads what loads once
+  const long faults = std::async(std::launch::async, prepare).get();
+  std::printf("a 2048^2 material texture on a fresh thread: %ld page faults\n", faults);
+  EXPECT_LT(faults, 3000) << "~35000 if its buffers were in 4 KB pages";
 }
 
 }  // namespace

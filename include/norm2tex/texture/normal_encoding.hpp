@@ -15,8 +15,10 @@ cv::Mat encodeNormalMap(const cv::Mat1f& dx, const cv::Mat1f& dy, NormalConventi
                         int depth, const cv::Mat1b& mask = cv::Mat1b());
 
 /// Same, from a height field in texel units: gradients by central differences (one-sided at
-/// the border and at mask edges, so slopes never straddle two UV islands).
+/// the border and at mask edges, so slopes never straddle two UV islands). With `with_alpha`
+/// the image is BGRA, alpha full scale where `mask` is set (everywhere if it is empty) and 0
+/// elsewhere: the layout NormalMap reads as "valid".
 cv::Mat encodeNormalMapFromHeight(const cv::Mat1f& height, NormalConvention convention, int depth,
-                                  const cv::Mat1b& mask = cv::Mat1b());
+                                  const cv::Mat1b& mask = cv::Mat1b(), bool with_alpha = false);
 
 }  // namespace norm2tex

@@ -3,26 +3,65 @@
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/texture/normal_encoding.hpp"
 
 namespace norm2tex {
 namespace {
 
+/// A texture-sized matrix filled with `value`, on huge pages: a 2048^2 texture's buffers are
+/// 4-16 MB each, and a background thread's fresh 4 KB pages cost ~13 us each to fault in.
+template <typename T>
+cv::Mat_<T> filled(cv::Size size, const T& value) {
+  cv::Mat_<T> matrix;
+  createWithHugePages(matrix, size.height, size.width);
+  matrix.setTo(value);
+  return matrix;
+}
+
+/// Where `island` equals `id` (255) or not (0); on huge pages, unlike `island == id`, which
+/// also faulted in a full-size int matrix of `id`.
+cv::Mat1b islandMask(const cv::Mat1i& island, int id) {
+  cv::Mat1b mask;
+  createWithHugePages(mask, island.rows, island.cols);
+  for (int r = 0; r < island.rows; ++r) {
+    const int* in = island.ptr<int>(r);
+    uchar* out = mask.ptr<uchar>(r);
+    for (int c = 0; c < island.cols; ++c) out[c] = in[c] == id ? 255 : 0;
+  }
+  return mask;
+}
+
 /// Normal map (BGRA, alpha = valid) from a height field in mm with a per-texel resolution.
 cv::Mat encodeWithAlpha(const cv::Mat1f& height_mm, const cv::Mat1f& mm_per_texel,
                         const cv::Mat1b& valid, int depth) {
   if (depth != CV_8U && depth != CV_16U) throw Error("normal map depth must be 8 or 16 bit");
-  cv::Mat1f height_texels(height_mm.size(), 0.0f);
-  cv::divide(height_mm, mm_per_texel, height_texels);
-  height_texels.setTo(0.0f, valid == 0);
-  const cv::Mat normals =
-      encodeNormalMapFromHeight(height_texels, NormalConvention::kOpenGL, depth, valid);
-  cv::Mat alpha;
-  valid.convertTo(alpha, depth, depth == CV_8U ? 1.0 : 257.0);
-  cv::Mat bgra;
-  cv::merge(std::vector<cv::Mat>{normals, alpha}, bgra);
-  return bgra;
+  cv::Mat1f height_texels;
+  createWithHugePages(height_texels, height_mm.rows, height_mm.cols);
+  for (int r = 0; r < height_mm.rows; ++r) {
+    const float* h = height_mm.ptr<float>(r);
+    const float* s = mm_per_texel.ptr<float>(r);
+    const uchar* ok = valid.ptr<uchar>(r);
+    float* out = height_texels.ptr<float>(r);
+    for (int c = 0; c < height_mm.cols; ++c) out[c] = ok[c] ? h[c] / s[c] : 0.0f;
+  }
+  return encodeNormalMapFromHeight(height_texels, NormalConvention::kOpenGL, depth, valid,
+                                   /*with_alpha=*/true);
+}
+
+/// Alpha back to the validity after padding copied whole texels outwards.
+void restoreAlpha(cv::Mat& bgra, const cv::Mat1b& valid) {
+  for (int r = 0; r < bgra.rows; ++r) {
+    const uchar* ok = valid.ptr<uchar>(r);
+    if (bgra.depth() == CV_8U) {
+      uchar* texel = bgra.ptr<uchar>(r);
+      for (int c = 0; c < bgra.cols; ++c) texel[4 * c + 3] = ok[c] ? 255 : 0;
+    } else {
+      ushort* texel = bgra.ptr<ushort>(r);
+      for (int c = 0; c < bgra.cols; ++c) texel[4 * c + 3] = ok[c] ? 65535 : 0;
+    }
+  }
 }
 
 }  // namespace
@@ -38,8 +77,8 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, int si
   const cv::Size extent(size, size);
   texture.height_mm = material.renderHeightMm(extent, mm_per_texel);
   texture.albedo = material.renderAlbedo(extent, mm_per_texel);
-  texture.valid = cv::Mat1b(extent, 255);
-  texture.mm_per_texel = cv::Mat1f(extent, static_cast<float>(mm_per_texel));
+  texture.valid = filled<uchar>(extent, 255);
+  texture.mm_per_texel = filled<float>(extent, static_cast<float>(mm_per_texel));
   texture.normal_map =
       encodeWithAlpha(texture.height_mm, texture.mm_per_texel, texture.valid, depth);
   return texture;
@@ -52,10 +91,15 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
     throw Error("renderMaterialTexture: the UV layout must be square");
   }
   MaterialTexture texture;
-  texture.height_mm = cv::Mat1f(extent, 0.0f);
-  if (with_albedo) texture.albedo = cv::Mat3b(extent, cv::Vec3b(0, 0, 0));
-  texture.valid = layout.island > 0;
-  texture.mm_per_texel = cv::Mat1f(extent, 0.0f);
+  texture.height_mm = filled<float>(extent, 0.0f);
+  if (with_albedo) texture.albedo = filled<cv::Vec3b>(extent, cv::Vec3b(0, 0, 0));
+  createWithHugePages(texture.valid, extent.height, extent.width);
+  for (int r = 0; r < extent.height; ++r) {  // cv::compare with a scalar made a 16 MB int copy
+    const int* island = layout.island.ptr<int>(r);
+    uchar* valid = texture.valid.ptr<uchar>(r);
+    for (int c = 0; c < extent.width; ++c) valid[c] = island[c] > 0 ? 255 : 0;
+  }
+  texture.mm_per_texel = filled<float>(extent, 0.0f);
   // Bounding box of each island, to evaluate the material only where that island lies.
   const int islands = static_cast<int>(layout.metres_per_uv.size());
   std::vector<cv::Rect> boxes(islands);
@@ -73,32 +117,26 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
     const double mm_per_texel = layout.metres_per_uv[id] * 1e3 / extent.width;
     const cv::Rect box = boxes[id];
     const cv::Point2d origin(box.x * mm_per_texel, box.y * mm_per_texel);
-    const cv::Mat1b mask = layout.island(box) == id;
+    const cv::Mat1b mask = islandMask(layout.island(box), id);
     material.renderHeightMm(box.size(), mm_per_texel, origin).copyTo(texture.height_mm(box), mask);
     if (with_albedo) {
       material.renderAlbedo(box.size(), mm_per_texel, origin).copyTo(texture.albedo(box), mask);
     }
     texture.mm_per_texel(box).setTo(static_cast<float>(mm_per_texel), mask);
   }
-  cv::Mat1f safe_resolution = texture.mm_per_texel.clone();
-  safe_resolution.setTo(1.0f, texture.valid == 0);  // avoids 0/0 outside islands
-  texture.normal_map = encodeWithAlpha(texture.height_mm, safe_resolution, texture.valid, depth);
+  texture.normal_map =
+      encodeWithAlpha(texture.height_mm, texture.mm_per_texel, texture.valid, depth);
 
   // Padding: colours (not alpha) grow outwards so bilinear look-ups at borders stay on-island.
-  if (padding_texels > 0) {
-    std::vector<cv::Mat> channels;
-    cv::split(texture.normal_map, channels);
-    cv::Mat bgr;
-    cv::merge(std::vector<cv::Mat>{channels[0], channels[1], channels[2]}, bgr);
-    padIslands(bgr, layout.island, padding_texels);
+  // Whole texels are copied, then alpha is set back to the validity.
+  if (padding_texels > 0 &&
+      cv::countNonZero(texture.valid) < static_cast<int>(texture.valid.total())) {
+    padIslands(texture.normal_map, layout.island, padding_texels);
+    restoreAlpha(texture.normal_map, texture.valid);
     if (with_albedo) {
       cv::Mat albedo = texture.albedo;
       padIslands(albedo, layout.island, padding_texels);
     }
-    std::vector<cv::Mat> padded;
-    cv::split(bgr, padded);
-    padded.push_back(channels[3]);
-    cv::merge(padded, texture.normal_map);
   }
   return texture;
 }

@@ -5,6 +5,7 @@
 
 #include "materials/materials.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 
 namespace norm2tex {
 namespace {
@@ -68,7 +69,8 @@ namespace {
 /// callers, through texelX / texelY).
 template <typename Pixel, typename Function>
 cv::Mat_<Pixel> renderGrid(cv::Size size, Function at) {
-  cv::Mat_<Pixel> image(size);
+  cv::Mat_<Pixel> image;
+  createWithHugePages(image, size.height, size.width);  // a 2048^2 texture's 16 MB
   for (int r = 0; r < size.height; ++r) {
     Pixel* row = image.template ptr<Pixel>(r);
     for (int c = 0; c < size.width; ++c) row[c] = at(r, c);

@@ -12,6 +12,7 @@
 
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/mesh/uv_unwrap.hpp"
 
 namespace norm2tex {
@@ -106,7 +107,8 @@ UvLayout computeUvLayout(const TexturedMesh& mesh, cv::Size size) {
   // between the edges' crossings; an edge's crossing is computed from its endpoints in a fixed
   // order, so two triangles sharing the edge get the same bits and no centre falls between.
   const int W = size.width, H = size.height;
-  layout.island = cv::Mat1i(H, W, 0);
+  createWithHugePages(layout.island, H, W);  // 16 MB at 2048^2: see huge_pages.hpp
+  layout.island.setTo(0);
   std::vector<int> unclaimed_in_row(H, W);
   int64_t unclaimed = static_cast<int64_t>(W) * H;
   for (int t = 0; t < triangle_count && unclaimed > 0; ++t) {
@@ -173,8 +175,14 @@ cv::Mat1i padIslands(cv::Mat& image, const cv::Mat1i& island, int texels) {
   }
   detail::requireParameter(texels >= 0, "padIslands: texels", texels, ">= 0");
   cv::Mat1i grown = island.clone();
-  if (texels == 0) return grown;
   const int rows = island.rows, cols = island.cols;
+  // A layout that covers every texel (a tiling texture) has nothing to pad.
+  bool any_empty = false;
+  for (int r = 0; r < rows && !any_empty; ++r) {
+    const int* in = island.ptr<int>(r);
+    any_empty = std::find(in, in + cols, 0) != in + cols;
+  }
+  if (texels == 0 || !any_empty) return grown;
   const int64_t limit = static_cast<int64_t>(texels) * texels;
 
   // Exact Euclidean nearest island texel within `texels`: per row the nearest island column

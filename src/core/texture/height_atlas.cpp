@@ -13,6 +13,7 @@
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/common/simd_dispatch.hpp"
 #include "norm2tex/texture/uv_islands.hpp"
 
@@ -202,7 +203,7 @@ void HeightAtlas::finish() {
       island_count_ = std::max(island_count_, label[c]);
     }
   }
-  interior_.create(labels_.size());
+  createWithHugePages(interior_, labels_.rows, labels_.cols);  // see huge_pages.hpp
   for (int r = 0; r < labels_.rows; ++r) {
     const int* row = labels_.ptr<int>(r);
     const int* next = labels_.ptr<int>((r + 1) % labels_.rows);

@@ -173,7 +173,10 @@ HeightAtlas bakeHeightAtlas(const NormalMap& normal_map, const BakeOptions& opti
   UvIslands islands = findUvIslands(normal_map.valid());
   BakeReport summary;
   cv::Mat1f global = detail::integrateIslands(normal_map, islands, options, progress, summary);
-  HeightAtlas atlas = detail::finishAtlas(std::move(global), normal_map.valid().clone(),
+  cv::Mat1b valid;  // the atlas's own copy, on huge pages like its heights
+  createWithHugePages(valid, normal_map.rows(), normal_map.cols());
+  normal_map.valid().copyTo(valid);
+  HeightAtlas atlas = detail::finishAtlas(std::move(global), std::move(valid),
                                           std::move(islands.labels), options, summary);
   if (report != nullptr) *report = summary;
   return atlas;
