@@ -20,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/render/object_texture.hpp"
@@ -375,6 +376,22 @@ bool transparentHugePagesOff() {
   std::string modes;
   std::getline(file, modes);
   return !file || modes.find("[never]") != std::string::npos;
+}
+
+TEST(MemoryReuse, AFreedHugePageMatrixIsTheNextOneOfItsSizeAlreadyFaultedIn) {
+  const auto touch = [](int rows, int cols) {
+    cv::Mat1f matrix;
+    createWithHugePages(matrix, rows, cols);
+    matrix.setTo(1.0f);
+  };
+  touch(2048, 2048);  // 16 MB, freed at once
+  long faults = -1;
+  std::thread([&] {  // another thread, like the next variant's preparation
+    const long before = threadPageFaults();
+    touch(2048, 2048);
+    faults = threadPageFaults() - before;
+  }).join();
+  EXPECT_LT(faults, 8) << "a fresh 16 MB mapping faults 8 huge or 4096 small pages";
 }
 
 TEST(MemoryReuse, ATexturePreparedOnAFreshThreadFaultsInFewPages) {

@@ -12,7 +12,9 @@ namespace norm2tex {
 /// 512 pages for about the price of one (256 MB: ~0.75 s with 4 KB pages, ~25 ms with huge
 /// pages when the kernel has them free). Where the kernel has no huge page at hand (THP off,
 /// memory fragmented) the mapping simply falls back to 4 KB pages: same result, old speed.
-/// Thread-safe; lives for the whole process.
+/// Freed mappings (up to 512 MB) are kept and handed to the next matrix of the same mapping
+/// length, already faulted in: contents are never zeroed. Thread-safe; lives for the whole
+/// process.
 cv::MatAllocator* hugePageAllocator();
 
 /// Makes `matrix` a fresh rows x cols matrix of `type` from hugePageAllocator() (contents
