@@ -390,7 +390,8 @@ TEST(MemoryReuse, AFreedHugePageMatrixIsTheNextOneOfItsSizeAlreadyFaultedIn) {
     const long before = threadPageFaults();
     touch(2048, 2048);
     faults = threadPageFaults() - before;
-  }).join();
+  })
+      .join();
   EXPECT_LT(faults, 8) << "a fresh 16 MB mapping faults 8 huge or 4096 small pages";
 }
 
