@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
+#include "materials/noise.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/procedural_material.hpp"
@@ -237,6 +238,36 @@ TEST(Material, GridEvaluationEqualsPerPoint) {
   }
   expectError([] { makeMaterial("wood")->renderHeightMm({0, 4}, 0.05); }, {"size"});
   expectError([] { makeMaterial("wood")->renderHeightMm({4, 4}, 0.0); }, {"mm_per_texel"});
+}
+
+TEST(Noise, CachedLookUpsGiveTheUncachedBits) {
+  // The materials keep each noise stream's last lattice cell per thread (noise.hpp): a walk
+  // over a grid, with jumps back and forth, negative coordinates and two streams sharing one
+  // cache, must give exactly the uncached values.
+  noise::GradientCell cell;
+  noise::GradientInterval interval;
+  noise::FbmCache<3> fbm;
+  noise::WorleyCell worley;
+  cv::RNG rng(5);
+  int outer_ring = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const std::uint64_t seed = i % 7 == 0 ? 99 : 42;  // a second stream through the same cache
+    const bool jump = i % 50 == 0;
+    const double x = jump ? rng.uniform(-40.0, 40.0) : -3.7 + 0.013 * (i % 700);
+    const double y = jump ? rng.uniform(-40.0, 40.0) : -1.2 + 0.029 * (i / 700);
+    EXPECT_EQ(noise::gradient2(cell, seed, x, y), noise::gradient2(seed, x, y)) << x << " " << y;
+    EXPECT_EQ(noise::gradient1(interval, seed, x), noise::gradient1(seed, x)) << x;
+    const int octaves = 1 + i % 5;  // beyond the cache's 3 as well
+    EXPECT_EQ(noise::fbm2(fbm, seed, x, y, octaves, 0.6), noise::fbm2(seed, x, y, octaves, 0.6));
+    const noise::Worley cached = noise::worley2(worley, seed, 3.0 * x, 3.0 * y);
+    const noise::Worley direct = noise::worley2(seed, 3.0 * x, 3.0 * y);
+    EXPECT_EQ(cached.f1, direct.f1);
+    EXPECT_EQ(cached.f2, direct.f2);
+    EXPECT_EQ(cached.id, direct.id);
+    if (direct.f2 > 1.1) ++outer_ring;
+    if (HasFailure()) break;
+  }
+  EXPECT_GT(outer_ring, 0) << "no look-up reached Worley's outer ring of cells";
 }
 
 TEST(Material, HeightIsContinuous) {

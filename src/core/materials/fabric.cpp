@@ -137,8 +137,9 @@ class Fabric final : public ProceduralMaterial {
           seed_weft_, j, b, a, [&](std::int64_t i) { return !warpOver(i, j); }, &profile);
       if (h > s.height) s = {h, 2, profile, 0.0};
     }
-    const double f = 3.0 / spacing_;  // fuzz at a third of the thread pitch and finer
-    s.fuzz = noise::fbm2(seed_fuzz_, x * f, y * f, 3);
+    const double f = 3.0 / spacing_;       // fuzz at a third of the thread pitch and finer
+    thread_local noise::FbmCache<3> fuzz;  // see noise.hpp: same bits, fewer hashes
+    s.fuzz = noise::fbm2(fuzz, seed_fuzz_, x * f, y * f, 3);
     s.height += fuzz_ * s.fuzz;
     return s;
   }

@@ -59,41 +59,110 @@ namespace detail {
 extern const double kGradients[16][2];
 }  // namespace detail
 
-/// 2-D gradient (Perlin-style) noise, roughly in [-1, 1], zero at lattice points, C2.
-inline double gradient2(std::uint64_t seed, double x, double y) {
-  const std::int64_t ix = floorInt(x), iy = floorInt(y);
-  const double fx = x - static_cast<double>(ix), fy = y - static_cast<double>(iy);
-  const auto corner = [&](std::int64_t cx, std::int64_t cy, double dx, double dy) {
-    const double* g = detail::kGradients[hash2(seed, cx, cy) >> 60];
-    return g[0] * dx + g[1] * dy;
-  };
-  const double n00 = corner(ix, iy, fx, fy);
-  const double n10 = corner(ix + 1, iy, fx - 1.0, fy);
-  const double n01 = corner(ix, iy + 1, fx, fy - 1.0);
-  const double n11 = corner(ix + 1, iy + 1, fx - 1.0, fy - 1.0);
+namespace detail {
+/// One lattice corner's gradient: the hash's top 4 bits pick one of kGradients.
+inline const double* cornerGradient(std::uint64_t seed, std::int64_t cx, std::int64_t cy) {
+  return kGradients[hash2(seed, cx, cy) >> 60];
+}
+
+/// gradient2's blend of its cell's four corner gradients at (fx, fy) inside the cell.
+inline double blendCorners(const double* const g[4], double fx, double fy) {
+  const double n00 = g[0][0] * fx + g[0][1] * fy;
+  const double n10 = g[1][0] * (fx - 1.0) + g[1][1] * fy;
+  const double n01 = g[2][0] * fx + g[2][1] * (fy - 1.0);
+  const double n11 = g[3][0] * (fx - 1.0) + g[3][1] * (fy - 1.0);
   const double u = fade(fx), v = fade(fy);
   const double a = n00 + u * (n10 - n00), b = n01 + u * (n11 - n01);
   return 1.4 * (a + v * (b - a));  // 1.4: scales the extreme values near +-1
 }
+}  // namespace detail
+
+/// 2-D gradient (Perlin-style) noise, roughly in [-1, 1], zero at lattice points, C2.
+inline double gradient2(std::uint64_t seed, double x, double y) {
+  const std::int64_t ix = floorInt(x), iy = floorInt(y);
+  const double* const g[4] = {
+      detail::cornerGradient(seed, ix, iy), detail::cornerGradient(seed, ix + 1, iy),
+      detail::cornerGradient(seed, ix, iy + 1), detail::cornerGradient(seed, ix + 1, iy + 1)};
+  return detail::blendCorners(g, x - static_cast<double>(ix), y - static_cast<double>(iy));
+}
+
+/// The lattice cell one stream of gradient2 look-ups used last, with its corner gradients.
+/// Neighbouring texels of a rendered grid mostly fall in the same cell, whose four hashes are
+/// most of gradient2's cost: with a cache the result is the same, bit for bit, for less work.
+/// One cache per stream and thread (it is not synchronised).
+struct GradientCell {
+  bool used = false;
+  std::uint64_t seed = 0;
+  std::int64_t ix = 0, iy = 0;
+  const double* g[4] = {nullptr, nullptr, nullptr, nullptr};
+};
+
+/// gradient2 through a cache of its last cell.
+inline double gradient2(GradientCell& cell, std::uint64_t seed, double x, double y) {
+  const std::int64_t ix = floorInt(x), iy = floorInt(y);
+  if (!cell.used || cell.ix != ix || cell.iy != iy || cell.seed != seed) {
+    cell.g[0] = detail::cornerGradient(seed, ix, iy);
+    cell.g[1] = detail::cornerGradient(seed, ix + 1, iy);
+    cell.g[2] = detail::cornerGradient(seed, ix, iy + 1);
+    cell.g[3] = detail::cornerGradient(seed, ix + 1, iy + 1);
+    cell.used = true;
+    cell.seed = seed;
+    cell.ix = ix;
+    cell.iy = iy;
+  }
+  return detail::blendCorners(cell.g, x - static_cast<double>(ix), y - static_cast<double>(iy));
+}
 
 /// 1-D gradient noise, roughly in [-1, 1], zero at integers, C2.
-inline double gradient1(std::uint64_t seed, double x) {
-  const std::int64_t ix = floorInt(x);
-  const double f = x - static_cast<double>(ix);
-  const double g0 = unit(hash1(seed, ix)) * 2.0 - 1.0, g1 = unit(hash1(seed, ix + 1)) * 2.0 - 1.0;
+namespace detail {
+inline double gradientAt(std::uint64_t seed, std::int64_t i) {
+  return unit(hash1(seed, i)) * 2.0 - 1.0;
+}
+inline double blendEnds(double g0, double g1, double f) {
   const double n0 = g0 * f, n1 = g1 * (f - 1.0);
   return 2.0 * (n0 + fade(f) * (n1 - n0));
+}
+}  // namespace detail
+
+inline double gradient1(std::uint64_t seed, double x) {
+  const std::int64_t ix = floorInt(x);
+  return detail::blendEnds(detail::gradientAt(seed, ix), detail::gradientAt(seed, ix + 1),
+                           x - static_cast<double>(ix));
+}
+
+/// The interval one stream of gradient1 look-ups used last (see GradientCell).
+struct GradientInterval {
+  bool used = false;
+  std::uint64_t seed = 0;
+  std::int64_t ix = 0;
+  double g0 = 0.0, g1 = 0.0;
+};
+
+/// gradient1 through a cache of its last interval.
+inline double gradient1(GradientInterval& interval, std::uint64_t seed, double x) {
+  const std::int64_t ix = floorInt(x);
+  if (!interval.used || interval.ix != ix || interval.seed != seed) {
+    interval.g0 = detail::gradientAt(seed, ix);
+    interval.g1 = detail::gradientAt(seed, ix + 1);
+    interval.used = true;
+    interval.seed = seed;
+    interval.ix = ix;
+  }
+  return detail::blendEnds(interval.g0, interval.g1, x - static_cast<double>(ix));
 }
 
 /// Fractal Brownian motion of 2-D gradient noise: `octaves` octaves, frequency x2 and
 /// amplitude x`gain` per octave, each octave rotated by ~37 deg (hides the lattice's axes) and
 /// seeded on its own. Normalised by the sum of amplitudes: roughly in [-1, 1].
-inline double fbm2(std::uint64_t seed, double x, double y, int octaves, double gain = 0.5) {
+/// `octave(o, seed_o, x_o, y_o)` evaluates one octave's gradient2; the seeds are given.
+template <typename Octave, typename Seed>
+inline double fbm2With(const Seed& octave_seed, const Octave& octave, double x, double y,
+                       int octaves, double gain) {
   // cos / sin of 36.87 deg (a 3-4-5 triangle): exact in binary, no libm call.
   constexpr double kC = 0.8, kS = 0.6;
   double sum = 0.0, norm = 0.0, amplitude = 1.0;
   for (int o = 0; o < octaves; ++o) {
-    sum += amplitude * gradient2(derive(seed, o), x, y);
+    sum += amplitude * octave(o, octave_seed(o), x, y);
     norm += amplitude;
     amplitude *= gain;
     const double xr = 2.0 * (kC * x - kS * y), yr = 2.0 * (kS * x + kC * y);
@@ -103,45 +172,127 @@ inline double fbm2(std::uint64_t seed, double x, double y, int octaves, double g
   return norm > 0.0 ? sum / norm : 0.0;
 }
 
+inline double fbm2(std::uint64_t seed, double x, double y, int octaves, double gain = 0.5) {
+  return fbm2With([seed](int o) { return derive(seed, o); },
+                  [](int, std::uint64_t s, double xo, double yo) { return gradient2(s, xo, yo); },
+                  x, y, octaves, gain);
+}
+
+/// Per-octave caches of one fbm2 stream (see GradientCell), with its octave seeds.
+template <int kOctaves>
+struct FbmCache {
+  bool seeded = false;
+  std::uint64_t seed = 0;
+  std::uint64_t octave_seed[kOctaves] = {};
+  GradientCell cell[kOctaves];
+};
+
+/// fbm2 through per-octave caches; the same bits as fbm2. Octaves beyond the cache's are
+/// computed without one.
+template <int kOctaves>
+inline double fbm2(FbmCache<kOctaves>& cache, std::uint64_t seed, double x, double y, int octaves,
+                   double gain = 0.5) {
+  if (!cache.seeded || cache.seed != seed) {
+    for (int o = 0; o < kOctaves; ++o) cache.octave_seed[o] = derive(seed, o);
+    cache.seeded = true;
+    cache.seed = seed;
+  }
+  return fbm2With(
+      [&cache, seed](int o) { return o < kOctaves ? cache.octave_seed[o] : derive(seed, o); },
+      [&cache](int o, std::uint64_t s, double xo, double yo) {
+        return o < kOctaves ? gradient2(cache.cell[o], s, xo, yo) : gradient2(s, xo, yo);
+      },
+      x, y, octaves, gain);
+}
+
 /// Worley (cellular) noise on a jittered unit lattice: distances to the nearest (f1) and
 /// second-nearest (f2) feature point, and the nearest point's hash (a per-cell random id).
 struct Worley {
   double f1, f2;
   std::uint64_t id;
 };
-inline Worley worley2(std::uint64_t seed, double x, double y) {
-  const std::int64_t ix = floorInt(x), iy = floorInt(y);
-  const double fx = x - static_cast<double>(ix), fy = y - static_cast<double>(iy);
+
+namespace detail {
+/// One neighbour cell's feature point, offset i, j from the looked-up cell: (i + 0.1 + 0.8 u,
+/// j + 0.1 + 0.8 u') before the look-up's fraction is subtracted, and the cell's hash.
+struct WorleyPoint {
+  double x, y;
+  std::uint64_t id;
+};
+inline WorleyPoint worleyPoint(std::uint64_t seed, std::int64_t ix, std::int64_t iy, int i, int j) {
+  const std::uint64_t h = hash2(seed, ix + i, iy + j);
+  // Jitter in [0.1, 0.9]: every point lies at least 0.1 inside its cell.
+  return {i + 0.1 + 0.8 * unit(h), j + 0.1 + 0.8 * unit(mix64(h)), h};
+}
+
+/// worley2 given the 3 x 3 block of points around cell (ix, iy), row by row.
+inline Worley worleyFrom(const WorleyPoint (&block)[9], std::uint64_t seed, std::int64_t ix,
+                         std::int64_t iy, double fx, double fy) {
   double d1 = 1e30, d2 = 1e30;
   std::uint64_t id = 0;
-  const auto visit = [&](int i, int j) {
-    const std::uint64_t h = hash2(seed, ix + i, iy + j);
-    // Jitter in [0.1, 0.9]: every point lies at least 0.1 inside its cell.
-    const double px = i + 0.1 + 0.8 * unit(h) - fx;
-    const double py = j + 0.1 + 0.8 * unit(mix64(h)) - fy;
+  const auto visit = [&](const WorleyPoint& p) {
+    const double px = p.x - fx, py = p.y - fy;
     const double d = px * px + py * py;
     if (d < d1) {
       d2 = d1;
       d1 = d;
-      id = h;
+      id = p.id;
     } else if (d < d2) {
       d2 = d;
     }
   };
-  for (int j = -1; j <= 1; ++j) {
-    for (int i = -1; i <= 1; ++i) visit(i, j);
-  }
+  for (const WorleyPoint& p : block) visit(p);
   // Points two cells away are at least 1.1 away. Rarely the 3 x 3 block's second-nearest is
   // farther than that: then the outer ring decides, so f1 and f2 (and the relief) stay exact
   // and continuous.
   if (d2 > 1.21) {
     for (int j = -2; j <= 2; ++j) {
       for (int i = -2; i <= 2; ++i) {
-        if (i == -2 || i == 2 || j == -2 || j == 2) visit(i, j);
+        if (i == -2 || i == 2 || j == -2 || j == 2) visit(worleyPoint(seed, ix, iy, i, j));
       }
     }
   }
   return {std::sqrt(d1), std::sqrt(d2), id};
+}
+
+inline void worleyBlock(std::uint64_t seed, std::int64_t ix, std::int64_t iy,
+                        WorleyPoint (&block)[9]) {
+  int k = 0;
+  for (int j = -1; j <= 1; ++j) {
+    for (int i = -1; i <= 1; ++i) block[k++] = worleyPoint(seed, ix, iy, i, j);
+  }
+}
+}  // namespace detail
+
+inline Worley worley2(std::uint64_t seed, double x, double y) {
+  const std::int64_t ix = floorInt(x), iy = floorInt(y);
+  detail::WorleyPoint block[9];
+  detail::worleyBlock(seed, ix, iy, block);
+  return detail::worleyFrom(block, seed, ix, iy, x - static_cast<double>(ix),
+                            y - static_cast<double>(iy));
+}
+
+/// The 3 x 3 block of feature points around the cell one stream of worley2 look-ups used
+/// last (see GradientCell): 9 hashes saved whenever the next look-up is in the same cell.
+struct WorleyCell {
+  bool used = false;
+  std::uint64_t seed = 0;
+  std::int64_t ix = 0, iy = 0;
+  detail::WorleyPoint block[9];
+};
+
+/// worley2 through a cache of its last cell's block; the same bits as worley2.
+inline Worley worley2(WorleyCell& cell, std::uint64_t seed, double x, double y) {
+  const std::int64_t ix = floorInt(x), iy = floorInt(y);
+  if (!cell.used || cell.ix != ix || cell.iy != iy || cell.seed != seed) {
+    detail::worleyBlock(seed, ix, iy, cell.block);
+    cell.used = true;
+    cell.seed = seed;
+    cell.ix = ix;
+    cell.iy = iy;
+  }
+  return detail::worleyFrom(cell.block, seed, ix, iy, x - static_cast<double>(ix),
+                            y - static_cast<double>(iy));
 }
 
 /// A seed from text (FNV-1a): stable per parameter name, e.g. for variant draws.

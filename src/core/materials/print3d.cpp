@@ -84,12 +84,24 @@ class Print3d final : public ProceduralMaterial {
     return b * b;
   }
 
+  /// Noise look-ups of one thread's last texels (see noise.hpp); same bits as without.
+  struct Caches {
+    noise::GradientCell wobble;
+    bool layer_used = false;
+    std::uint64_t layer_seed = 0;
+    std::int64_t layer_index = 0;
+    std::uint64_t layer_hash = 0;
+    noise::GradientInterval bulge;
+  };
+
   Sample evaluate(double x, double y) const {
+    thread_local Caches caches;
     const double u = cos_ * x + sin_ * y;   // along the layers
     const double v = -sin_ * x + cos_ * y;  // across (build direction)
     // The nozzle's path wanders slightly: layer lines wobble by up to a quarter pitch.
-    const double vw = v + 0.25 * variation_ * pitch_ *
-                              noise::gradient2(seed_wobble_, u / 1.5, v / (6.0 * pitch_));
+    const double vw =
+        v + 0.25 * variation_ * pitch_ *
+                noise::gradient2(caches.wobble, seed_wobble_, u / 1.5, v / (6.0 * pitch_));
     const double t = vw / pitch_;
     const std::int64_t n = noise::floorInt(t);
     const double q = 2.0 * (t - static_cast<double>(n)) - 1.0;  // -1 .. 1 across one layer
@@ -98,9 +110,15 @@ class Print3d final : public ProceduralMaterial {
     s.bead = 1.0 - q2 * q2;  // flat-topped bead, cusp at the layer seams
     // Each layer's bead: its own bulge, varying slowly along the layer (extrusion rate). The
     // bead factor multiplies a profile that is 0 at the seams, so layers join continuously.
-    const std::uint64_t layer = noise::hash1(seed_layer_, n);
+    if (!caches.layer_used || caches.layer_index != n || caches.layer_seed != seed_layer_) {
+      caches.layer_hash = noise::hash1(seed_layer_, n);
+      caches.layer_used = true;
+      caches.layer_seed = seed_layer_;
+      caches.layer_index = n;
+    }
+    const std::uint64_t layer = caches.layer_hash;
     const double bulge = 1.0 + variation_ * (noise::unit(layer) - 0.5) +
-                         0.3 * variation_ * noise::gradient1(layer, u / 0.8);
+                         0.3 * variation_ * noise::gradient1(caches.bulge, layer, u / 0.8);
     s.infill = 0.5 * (infillLine((n1x_ * x + n1y_ * y) / infill_spacing_ + phase1_) +
                       infillLine((n2x_ * x + n2y_ * y) / infill_spacing_ + phase2_));
     s.height = depth_ * (bulge * s.bead - 1.0) + infill_amplitude_ * s.infill;

@@ -86,12 +86,22 @@ class Rock final : public ProceduralMaterial {
     seed_rough_ = noise::derive(seed(), 4);
   }
 
+  /// Noise look-ups of one thread's last texels (see noise.hpp); same bits as without.
+  struct Caches {
+    noise::GradientCell warp_x, warp_y;
+    noise::WorleyCell cells;
+    noise::FbmCache<8> rough;  ///< up to the octaves parameter's maximum
+  };
+
   Sample evaluate(double x, double y) const {
+    thread_local Caches caches;
     // Everything in grain units.
     const double gx = x * inv_grain_, gy = y * inv_grain_;
-    const double wx = gx + warp_ * noise::gradient2(seed_warp_x_, 0.7 * gx, 0.7 * gy);
-    const double wy = gy + warp_ * noise::gradient2(seed_warp_y_, 0.7 * gx, 0.7 * gy);
-    const noise::Worley w = noise::worley2(seed_cells_, wx, wy);
+    const double wx =
+        gx + warp_ * noise::gradient2(caches.warp_x, seed_warp_x_, 0.7 * gx, 0.7 * gy);
+    const double wy =
+        gy + warp_ * noise::gradient2(caches.warp_y, seed_warp_y_, 0.7 * gx, 0.7 * gy);
+    const noise::Worley w = noise::worley2(caches.cells, seed_cells_, wx, wy);
     // f2 - f1 is 0 on the boundary between two grains: the shoulder, and with it the grain's
     // random height, vanishes there, so the relief is continuous across grains.
     const double e = w.f2 - w.f1;
@@ -101,7 +111,7 @@ class Rock final : public ProceduralMaterial {
     Sample s;
     s.edge = edge;
     s.grain = edge * dome * (0.45 + 0.55 * noise::unit(noise::mix64(w.id ^ 0x5555)));
-    s.rough = noise::fbm2(seed_rough_, 1.5 * gx, 1.5 * gy, octaves_, gain_);
+    s.rough = noise::fbm2(caches.rough, seed_rough_, 1.5 * gx, 1.5 * gy, octaves_, gain_);
     s.id = w.id;
     return s;
   }

@@ -109,24 +109,42 @@ class Wood final : public ProceduralMaterial {
     seed_pores_ = noise::derive(seed(), 3);
   }
 
+  /// One pore cell's hash draws, which depend on the seed and the cell only.
+  struct PoreCell {
+    bool used = false;
+    std::uint64_t seed = 0;
+    std::int64_t iu = 0, iv = 0;
+    double at_u = 0, at_v = 0, size_draw = 0, depth_draw = 0;
+  };
+
+  /// Noise look-ups of one thread's last texels: neighbouring texels share lattice and pore
+  /// cells, so most hashes are reused (noise.hpp). Same bits as without.
+  struct Caches {
+    noise::FbmCache<3> warp;
+    noise::FbmCache<2> fibre;
+    PoreCell pores[64];  ///< direct-mapped by cell
+  };
+
   Sample evaluate(double x, double y) const {
+    thread_local Caches caches;
     const double u = cos_ * x + sin_ * y;   // along the grain
     const double v = -sin_ * x + cos_ * y;  // across
-    const double vw = v + warp_ * noise::fbm2(seed_warp_, u * warp_scale_u_, v * warp_scale_v_, 3);
+    const double vw =
+        v + warp_ * noise::fbm2(caches.warp, seed_warp_, u * warp_scale_u_, v * warp_scale_v_, 3);
     const double t = vw / spacing_;
     const double f = t - static_cast<double>(noise::floorInt(t));
     Sample s;
     s.latewood = noise::smoothstep(1.0 - latewood_ - rise_, 1.0 - latewood_, f) *
                  (1.0 - noise::smoothstep(1.0 - fall_, 1.0, f));
     // Fibres: long along the grain (2.5 mm), fine across it (0.15 mm); they follow the rings.
-    s.fibre = noise::fbm2(seed_fibre_, u * (1.0 / 2.5), vw * (1.0 / 0.15), 2);
-    s.pore = pores_ ? pore(u, vw) : 0.0;
+    s.fibre = noise::fbm2(caches.fibre, seed_fibre_, u * (1.0 / 2.5), vw * (1.0 / 0.15), 2);
+    s.pore = pores_ ? pore(u, vw, caches.pores) : 0.0;
     return s;
   }
 
   /// Deepest pore profile (1 - r^2)^2 over the elliptic pores near (u, v): one pore per cell of
   /// a jittered grid in (along, warped across) coordinates, size varying +-30%.
-  double pore(double u, double v) const {
+  double pore(double u, double v, PoreCell (&cells)[64]) const {
     const double reach_u = 1.3 * pore_half_length_, reach_v = 1.3 * pore_half_width_;
     const std::int64_t iu0 = noise::floorInt((u - reach_u) / cell_u_);
     const std::int64_t iu1 = noise::floorInt((u + reach_u) / cell_u_);
@@ -135,17 +153,28 @@ class Wood final : public ProceduralMaterial {
     double deepest = 0.0;
     for (std::int64_t iv = iv0; iv <= iv1; ++iv) {
       for (std::int64_t iu = iu0; iu <= iu1; ++iu) {
-        const std::uint64_t h = noise::hash2(seed_pores_, iu, iv);
-        const std::uint64_t h2 = noise::mix64(h), h3 = noise::mix64(h2);
-        const double size = 0.7 + 0.6 * noise::unit(h3);
+        PoreCell& cell =
+            cells[(static_cast<std::uint64_t>(iu) * 31u + static_cast<std::uint64_t>(iv)) & 63u];
+        if (!cell.used || cell.iu != iu || cell.iv != iv || cell.seed != seed_pores_) {
+          const std::uint64_t h = noise::hash2(seed_pores_, iu, iv);
+          const std::uint64_t h2 = noise::mix64(h), h3 = noise::mix64(h2);
+          cell = {true,
+                  seed_pores_,
+                  iu,
+                  iv,
+                  noise::unit(h),
+                  noise::unit(h2),
+                  noise::unit(h3),
+                  noise::unit(noise::mix64(h3))};
+        }
+        const double size = 0.7 + 0.6 * cell.size_draw;
         const double du =
-            (u - cell_u_ * (static_cast<double>(iu) + noise::unit(h))) / (pore_half_length_ * size);
+            (u - cell_u_ * (static_cast<double>(iu) + cell.at_u)) / (pore_half_length_ * size);
         const double dv =
-            (v - cell_v_ * (static_cast<double>(iv) + noise::unit(h2))) / (pore_half_width_ * size);
+            (v - cell_v_ * (static_cast<double>(iv) + cell.at_v)) / (pore_half_width_ * size);
         const double r2 = du * du + dv * dv;
         if (r2 < 1.0) {
-          const double depth =
-              (0.6 + 0.4 * noise::unit(noise::mix64(h3))) * (1.0 - r2) * (1.0 - r2);
+          const double depth = (0.6 + 0.4 * cell.depth_draw) * (1.0 - r2) * (1.0 - r2);
           if (depth > deepest) deepest = depth;
         }
       }
