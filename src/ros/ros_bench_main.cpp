@@ -131,9 +131,11 @@ int main(int argc, char** argv) {
           frames / 30.0 + 30);
   std::vector<double> latency_ms;
   int incomplete = 0;
+  // The newest frame may still have its second image on the way when counting stops.
+  const ros::Time newest = arrivals.count.rbegin()->first;
   for (const auto& [stamp, n] : arrivals.count) {
     if (n != 2) {
-      ++incomplete;
+      if (stamp != newest) ++incomplete;
       continue;
     }
     latency_ms.push_back(1e3 * (arrivals.last[stamp].toSec() - stamp.toSec()));
