@@ -59,11 +59,9 @@ BENCHMARK_CAPTURE(BM_Texgen, print3d, std::string("print3d"))
     ->Arg(2048)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_MaterialVariant, wood, std::string("wood"))->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_MaterialVariant, fabric, std::string("fabric"))
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MaterialVariant, fabric, std::string("fabric"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_MaterialVariant, rock, std::string("rock"))->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_MaterialVariant, smooth, std::string("smooth"))
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MaterialVariant, smooth, std::string("smooth"))->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_MaterialVariant, print3d, std::string("print3d"))
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Unwrap_200kTriangles)->Unit(benchmark::kMillisecond);
