@@ -131,11 +131,13 @@ int main(int argc, char** argv) {
           frames / 30.0 + 30);
   std::vector<double> latency_ms;
   int incomplete = 0;
-  // The newest frame may still have its second image on the way when counting stops.
+  // The oldest frame may have had its first image before counting started, the newest its
+  // second still on the way when counting stopped: neither is a frame with one image.
+  const ros::Time oldest = arrivals.count.begin()->first;
   const ros::Time newest = arrivals.count.rbegin()->first;
   for (const auto& [stamp, n] : arrivals.count) {
     if (n != 2) {
-      if (stamp != newest) ++incomplete;
+      if (stamp != oldest && stamp != newest) ++incomplete;
       continue;
     }
     latency_ms.push_back(1e3 * (arrivals.last[stamp].toSec() - stamp.toSec()));
