@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "materials.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 #include "noise.hpp"
 
 namespace norm2tex {
@@ -66,7 +67,10 @@ class Smooth final : public ProceduralMaterial {
   cv::Mat1f renderHeightMm(cv::Size size, double mm_per_texel,
                            cv::Point2d origin_mm) const override {
     checkGrid(size, mm_per_texel);
-    cv::Mat1d deepest(size, 0.0);
+    // Texture-sized buffers on huge pages (48 MB at 2048^2): see huge_pages.hpp.
+    cv::Mat1d deepest;
+    createWithHugePages(deepest, size.height, size.width);
+    deepest.setTo(0.0);
     if (scratches_) {
       const double x0 = texelX(0, mm_per_texel, origin_mm);
       const double x1 = texelX(size.width - 1, mm_per_texel, origin_mm);
@@ -104,7 +108,8 @@ class Smooth final : public ProceduralMaterial {
         }
       }
     }
-    cv::Mat1f height(size);
+    cv::Mat1f height;
+    createWithHugePages(height, size.height, size.width);
     for (int r = 0; r < size.height; ++r) {
       const double y = texelY(r, mm_per_texel, origin_mm);
       const double* scratch = deepest.ptr<double>(r);
