@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "materials.hpp"
-#include "norm2tex/common/huge_pages.hpp"
 #include "noise.hpp"
+#include "norm2tex/common/huge_pages.hpp"
 
 namespace norm2tex {
 namespace materials {
