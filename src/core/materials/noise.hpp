@@ -4,7 +4,9 @@
 // argument, there is no global RNG state, and results depend only on IEEE double arithmetic
 // (+, *, correctly rounded sqrt; no other libm call), so the same inputs give the same bits.
 //
-// The hot functions are inline: materials call them millions of times per texture.
+// The hot functions are inline: materials call them millions of times per texture. Each has
+// an overload taking a cache of the lattice cell it used last (GradientCell, FbmCache,
+// WorleyCell, ...): a cache changes how often hashes are computed, never a result.
 
 #include <cmath>
 #include <cstdint>
