@@ -259,6 +259,8 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
 ContactSim::~ContactSim() {
   stop_clock_ = true;
   if (clock_thread_.joinable()) clock_thread_.join();
+  service_queue_.disable();  // wakes its spinner at once instead of at its next 0.1 s poll
+  if (service_spinner_) service_spinner_->stop();
 }
 
 void ContactSim::runClock() {

@@ -167,6 +167,7 @@ ProbeSim::ProbeSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
 ProbeSim::~ProbeSim() {
   stop_ = true;
   if (runner_.joinable()) runner_.join();
+  service_queue_.disable();  // wakes its spinner at once instead of at its next 0.1 s poll
   if (service_spinner_) service_spinner_->stop();
 }
 

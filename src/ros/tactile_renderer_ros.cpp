@@ -156,6 +156,14 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   rendered_pub_.publish(ready);
 }
 
+TactileRendererRos::~TactileRendererRos() {
+  // Disabled queues wake their waiters at once: the frames' spinner would otherwise notice the
+  // stop at its next 0.1 s poll, and a manager's shutdown waits for every such thread in turn.
+  frame_queue_.disable();
+  tf_queue_.disable();
+  frame_spinner_.reset();
+}
+
 void TactileRendererRos::useTexture(const TextureSource& source, const std::string& key) {
   // On this thread, on the renderer's own mesh: a mesh without UVs is unwrapped here (once, at
   // start-up, before any frame).

@@ -69,6 +69,7 @@ class TactileRendererRos {
  public:
   /// Throws Error (bad parameter, unreadable sensor/scene/mesh/texture/background).
   TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~TactileRendererRos();
 
  private:
   void onFrame(const SimFrame::ConstPtr& frame);

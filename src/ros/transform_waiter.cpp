@@ -44,6 +44,10 @@ bool TransformWaiter::waitServingQueue(const std::string& target, const std::str
     const std::chrono::duration<double> left = deadline - now;
     tf_queue_->callAvailable(ros::WallDuration(left.count()));
     if (buffer_.canTransform(target, source, stamp)) return true;
+    if (!tf_queue_->isEnabled()) {  // disabled: its owner is shutting down
+      if (why != nullptr) *why = "shutting down";
+      return false;
+    }
   }
   return buffer_.canTransform(target, source, stamp, why);
 }
