@@ -116,7 +116,7 @@ ProbeSim::ProbeSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   object_ = params_.mesh.empty() ? loadObjectMesh(scene.object.mesh, scene.object.scale)
                                  : loadObjectMesh(params_.mesh, params_.scale);
   object_name_ = params_.mesh.empty() ? scene.object.name
-                                     : std::filesystem::path(params_.mesh).stem().string();
+                                      : std::filesystem::path(params_.mesh).stem().string();
   meter_ = std::make_unique<ContactPatchMeter>(sensor_);
 
   std::vector<std::pair<std::string, int>> plan;
@@ -150,11 +150,12 @@ ProbeSim::ProbeSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   if (!params_.autostart) step_srv_ = service_nh.advertiseService("step", &ProbeSim::onStep, this);
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   service_spinner_->start();
-  ROS_INFO("probe_sim: %zu material(s), %zu texture blocks, shard %d of %d: %lu frames in %zu "
-           "presses of up to %d frames; object %s",
-           params_.materials.size(), schedule_->blocks().size(), params_.shard, params_.num_shards,
-           static_cast<unsigned long>(schedule_->frames()), schedule_->presses().size(),
-           frames_per_press, params_.mesh.empty() ? scene.object.mesh.c_str() : params_.mesh.c_str());
+  ROS_INFO(
+      "probe_sim: %zu material(s), %zu texture blocks, shard %d of %d: %lu frames in %zu "
+      "presses of up to %d frames; object %s",
+      params_.materials.size(), schedule_->blocks().size(), params_.shard, params_.num_shards,
+      static_cast<unsigned long>(schedule_->frames()), schedule_->presses().size(),
+      frames_per_press, params_.mesh.empty() ? scene.object.mesh.c_str() : params_.mesh.c_str());
   {
     rosgraph_msgs::Clock clock;
     clock.clock = stamp();
@@ -222,7 +223,7 @@ bool ProbeSim::onStep(Step::Request& request, Step::Response& response) {
 }
 
 bool ProbeSim::advanceFrame() {
-  lock_step_->waitUntilReady();  // at once after the first time
+  lock_step_->waitUntilReady();                  // at once after the first time
   if (next_in_press_ >= press_frames_.size()) {  // the next press: a new episode
     if (next_press_ >= schedule_->presses().size()) return false;
     const ProbePress& press = schedule_->presses()[next_press_++];
@@ -311,10 +312,11 @@ bool ProbeSim::advanceFrame() {
   if (frame.last) {
     missing_images_ += lock_step_->drain(frame_pub_);
     const double seconds = (ros::WallTime::now() - started_).toSec();
-    ROS_INFO("probe_sim: done, %ld frames of %zu presses in %.1f s (%.0f frames/s), %lu images "
-             "missing",
-             static_cast<long>(frame_), schedule_->presses().size(), seconds, frame_ / seconds,
-             static_cast<unsigned long>(missing_images_));
+    ROS_INFO(
+        "probe_sim: done, %ld frames of %zu presses in %.1f s (%.0f frames/s), %lu images "
+        "missing",
+        static_cast<long>(frame_), schedule_->presses().size(), seconds, frame_ / seconds,
+        static_cast<unsigned long>(missing_images_));
   }
   return true;
 }
