@@ -208,10 +208,12 @@ void HeightAtlas::finish() {
     const int* row = labels_.ptr<int>(r);
     const int* next = labels_.ptr<int>((r + 1) % labels_.rows);
     uchar* out = interior_.ptr<uchar>(r);
-    for (int c = 0; c < labels_.cols; ++c) {
-      const int c1 = (c + 1) % labels_.cols;
-      out[c] = row[c] != 0 && row[c1] == row[c] && next[c] == row[c] && next[c1] == row[c];
+    const int last = labels_.cols - 1;  // its right neighbour wraps to column 0
+    for (int c = 0; c < last; ++c) {
+      out[c] = row[c] != 0 && row[c + 1] == row[c] && next[c] == row[c] && next[c + 1] == row[c];
     }
+    out[last] = row[last] != 0 && row[0] == row[last] && next[last] == row[last] &&
+                next[0] == row[last];
   }
 }
 void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
