@@ -212,8 +212,8 @@ void HeightAtlas::finish() {
     for (int c = 0; c < last; ++c) {
       out[c] = row[c] != 0 && row[c + 1] == row[c] && next[c] == row[c] && next[c + 1] == row[c];
     }
-    out[last] = row[last] != 0 && row[0] == row[last] && next[last] == row[last] &&
-                next[0] == row[last];
+    out[last] =
+        row[last] != 0 && row[0] == row[last] && next[last] == row[last] && next[0] == row[last];
   }
 }
 void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
