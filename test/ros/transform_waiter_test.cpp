@@ -1,5 +1,7 @@
 // TransformWaiter: a pose at an exact stamp, waited for without polling (no master needed).
 #include <atomic>
+#include <chrono>
+#include <string>
 #include <thread>
 
 #include <ros/callback_queue.h>
@@ -117,6 +119,27 @@ TEST(TransformWaiterTest, WithItsQueueTheWaitingThreadInsertsThePosesItself) {
   waiter.insertReceived();
   EXPECT_TRUE(tf_queue.empty());
   EXPECT_TRUE(buffer.canTransform("gel", "object", ros::Time(5.5)));
+}
+
+TEST(TransformWaiterTest, AWaitReturnsWhenItsQueueIsDisabledAtShutdown) {
+  // The renderer disables its TF queue when it is destroyed: a wait under way must end then,
+  // not run to its timeout (the destructor joins the thread that waits).
+  tf2::BufferCore buffer;
+  ros::CallbackQueue tf_queue;
+  TransformWaiter waiter(buffer, tf_queue);
+  buffer.setTransform(objectInGel(1.0, 0.0), "test");
+  std::thread owner([&tf_queue] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the wait is under way
+    tf_queue.disable();
+  });
+  std::string why;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(waiter.wait("gel", "object", ros::Time(2.0), 30.0, &why));
+  const double waited =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  owner.join();
+  EXPECT_EQ(why, "shutting down");
+  EXPECT_LT(waited, 15.0) << "the wait ran towards its 30 s timeout";
 }
 
 }  // namespace

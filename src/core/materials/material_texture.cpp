@@ -20,15 +20,16 @@ cv::Mat_<T> filled(cv::Size size, const T& value) {
   return matrix;
 }
 
-/// Where `island` equals `id` (255) or not (0); on huge pages, unlike `island == id`, which
-/// also faulted in a full-size int matrix of `id`.
-cv::Mat1b islandMask(const cv::Mat1i& island, int id) {
+/// 255 where `keep(label)` holds for the island map's label, else 0; on huge pages, unlike
+/// `island == id`, which also faulted in a full-size int matrix of `id`.
+template <typename Keep>
+cv::Mat1b islandMask(const cv::Mat1i& island, Keep keep) {
   cv::Mat1b mask;
   createWithHugePages(mask, island.rows, island.cols);
   for (int r = 0; r < island.rows; ++r) {
     const int* in = island.ptr<int>(r);
     uchar* out = mask.ptr<uchar>(r);
-    for (int c = 0; c < island.cols; ++c) out[c] = in[c] == id ? 255 : 0;
+    for (int c = 0; c < island.cols; ++c) out[c] = keep(in[c]) ? 255 : 0;
   }
   return mask;
 }
@@ -93,12 +94,7 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
   MaterialTexture texture;
   texture.height_mm = filled<float>(extent, 0.0f);
   if (with_albedo) texture.albedo = filled<cv::Vec3b>(extent, cv::Vec3b(0, 0, 0));
-  createWithHugePages(texture.valid, extent.height, extent.width);
-  for (int r = 0; r < extent.height; ++r) {  // cv::compare with a scalar made a 16 MB int copy
-    const int* island = layout.island.ptr<int>(r);
-    uchar* valid = texture.valid.ptr<uchar>(r);
-    for (int c = 0; c < extent.width; ++c) valid[c] = island[c] > 0 ? 255 : 0;
-  }
+  texture.valid = islandMask(layout.island, [](int label) { return label > 0; });
   texture.mm_per_texel = filled<float>(extent, 0.0f);
   // Bounding box of each island, to evaluate the material only where that island lies.
   const int islands = static_cast<int>(layout.metres_per_uv.size());
@@ -117,7 +113,7 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
     const double mm_per_texel = layout.metres_per_uv[id] * 1e3 / extent.width;
     const cv::Rect box = boxes[id];
     const cv::Point2d origin(box.x * mm_per_texel, box.y * mm_per_texel);
-    const cv::Mat1b mask = islandMask(layout.island(box), id);
+    const cv::Mat1b mask = islandMask(layout.island(box), [id](int label) { return label == id; });
     material.renderHeightMm(box.size(), mm_per_texel, origin).copyTo(texture.height_mm(box), mask);
     if (with_albedo) {
       material.renderAlbedo(box.size(), mm_per_texel, origin).copyTo(texture.albedo(box), mask);
