@@ -1,4 +1,8 @@
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -55,6 +59,63 @@ TEST(HeightRange, PercentilesInterpolateBetweenOrderStatistics) {
   const cv::Vec2f p = maskedPercentiles(h, cv::Mat1b(1, 11, 255), 25.0, 75.0);
   EXPECT_FLOAT_EQ(p[0], 2.5f);
   EXPECT_FLOAT_EQ(p[1], 7.5f);
+}
+
+/// The percentiles by their definition: sort the finite masked values, interpolate linearly.
+cv::Vec2f sortedPercentiles(const cv::Mat1f& h, const cv::Mat1b& mask, double low, double high) {
+  std::vector<float> values;
+  for (int r = 0; r < h.rows; ++r) {
+    for (int c = 0; c < h.cols; ++c) {
+      if (mask(r, c) && std::isfinite(h(r, c))) values.push_back(h(r, c));
+    }
+  }
+  std::sort(values.begin(), values.end());
+  const auto at = [&values](double percent) {
+    const double rank = percent / 100.0 * static_cast<double>(values.size() - 1);
+    const size_t below = static_cast<size_t>(std::floor(rank));
+    if (below + 1 >= values.size()) return values[below];
+    return static_cast<float>(values[below] + (rank - below) * (values[below + 1] - values[below]));
+  };
+  return {at(low), at(high)};
+}
+
+// The histogram search (vector range pass, float bins) against sorting, bit for bit: odd widths
+// (vector tails), masked texels, NaN and infinities, ties, a huge outlier that squeezes every
+// other value into one bin, and a range so narrow its bin scale overflows a float.
+TEST(HeightRange, PercentilesEqualSortingTheValues) {
+  std::mt19937 random(7);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  const auto check = [](const cv::Mat1f& h, const cv::Mat1b& mask, const std::string& what) {
+    for (const auto& p : {std::pair<double, double>{0.05, 99.95}, {0.0, 100.0}, {13.0, 50.5}}) {
+      const cv::Vec2f expected = sortedPercentiles(h, mask, p.first, p.second);
+      const cv::Vec2f got = maskedPercentiles(h, mask, p.first, p.second);
+      EXPECT_EQ(got[0], expected[0]) << what << " low " << p.first;
+      EXPECT_EQ(got[1], expected[1]) << what << " high " << p.second;
+    }
+  };
+  cv::Mat1f h(257, 203);
+  cv::Mat1b mask(h.size());
+  for (int r = 0; r < h.rows; ++r) {
+    for (int c = 0; c < h.cols; ++c) {
+      h(r, c) = std::round(normal(random) * 64.0f) / 64.0f;  // many ties
+      mask(r, c) = random() % 5 != 0 ? 255 : 0;
+    }
+  }
+  h(3, 4) = std::numeric_limits<float>::quiet_NaN();
+  h(5, 6) = std::numeric_limits<float>::infinity();
+  h(7, 202) = -std::numeric_limits<float>::infinity();
+  mask(3, 4) = mask(5, 6) = mask(7, 202) = 255;
+  check(h, mask, "normal");
+  h(100, 100) = 1e30f;
+  mask(100, 100) = 255;
+  check(h, mask, "outlier");
+  cv::Mat1f narrow(33, 35);
+  for (int r = 0; r < narrow.rows; ++r) {
+    for (int c = 0; c < narrow.cols; ++c) {
+      narrow(r, c) = std::numeric_limits<float>::denorm_min() * static_cast<float>(random() % 9);
+    }
+  }
+  check(narrow, cv::Mat1b(narrow.size(), 255), "subnormal range");
 }
 
 TEST(HeightRange, OnlyMaskedTexelsCountAndTheRestBecomeZero) {

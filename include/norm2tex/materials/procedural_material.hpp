@@ -7,6 +7,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "norm2tex/common/huge_pages.hpp"
+
 namespace norm2tex {
 
 /// One tunable number of a procedural material, with its valid range and unit.
@@ -83,6 +85,24 @@ class ProceduralMaterial {
   }
   /// Throws Error unless size is non-empty and mm_per_texel is positive and finite.
   static void checkGrid(cv::Size size, double mm_per_texel);
+
+  /// The base renderHeightMm's loop around `height(x_mm, y_mm)` (a double): for overrides
+  /// that evaluate without a virtual call and a thread-local look-up per texel. Same values.
+  template <typename Height>
+  static cv::Mat1f renderHeightGrid(cv::Size size, double mm_per_texel, cv::Point2d origin_mm,
+                                    Height height) {
+    checkGrid(size, mm_per_texel);
+    cv::Mat1f image;
+    createWithHugePages(image, size.height, size.width);  // a 2048^2 texture's 16 MB
+    for (int r = 0; r < size.height; ++r) {
+      float* row = image.ptr<float>(r);
+      const double y = texelY(r, mm_per_texel, origin_mm);
+      for (int c = 0; c < size.width; ++c) {
+        row[c] = static_cast<float>(height(texelX(c, mm_per_texel, origin_mm), y));
+      }
+    }
+    return image;
+  }
 
  private:
   std::size_t indexOf(const std::string& name) const;

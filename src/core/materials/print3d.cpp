@@ -35,10 +35,19 @@ class Print3d final : public ProceduralMaterial {
 
   std::string name() const override { return "print3d"; }
 
-  double heightMm(double x_mm, double y_mm) const override { return evaluate(x_mm, y_mm).height; }
+  double heightMm(double x_mm, double y_mm) const override {
+    return evaluate(x_mm, y_mm, threadCaches()).height;
+  }
+
+  cv::Mat1f renderHeightMm(cv::Size size, double mm_per_texel,
+                           cv::Point2d origin_mm) const override {
+    Caches& caches = threadCaches();
+    return renderHeightGrid(size, mm_per_texel, origin_mm,
+                            [&](double x, double y) { return evaluate(x, y, caches).height; });
+  }
 
   cv::Vec3b albedo(double x_mm, double y_mm) const override {
-    const Sample s = evaluate(x_mm, y_mm);
+    const Sample s = evaluate(x_mm, y_mm, threadCaches());
     // Orange PLA: bead crowns catch the light, the cusps between layers look darker.
     const cv::Vec3d base(40, 120, 235);
     const double shade = 0.72 + 0.28 * s.bead + 0.03 * s.infill;
@@ -94,8 +103,12 @@ class Print3d final : public ProceduralMaterial {
     noise::GradientInterval bulge;
   };
 
-  Sample evaluate(double x, double y) const {
+  static Caches& threadCaches() {
     thread_local Caches caches;
+    return caches;
+  }
+
+  Sample evaluate(double x, double y, Caches& caches) const {
     const double u = cos_ * x + sin_ * y;   // along the layers
     const double v = -sin_ * x + cos_ * y;  // across (build direction)
     // The nozzle's path wanders slightly: layer lines wobble by up to a quarter pitch.
