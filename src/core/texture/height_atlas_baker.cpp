@@ -19,7 +19,7 @@ struct BakeWorkspace {
   explicit BakeWorkspace(const IntegrationOptions& integration) : integrator(integration) {}
   detail::ScratchBuffer<uchar> mask;
   detail::ScratchBuffer<float> dx, dy;
-  detail::ScratchBuffer<cv::Vec3f> smoothed;
+  detail::SlopeScratch smoothing;
   FrankotChellappaIntegrator integrator;
   detail::ReliefFilter relief;
 };
@@ -34,15 +34,13 @@ void integrateIsland(const cv::Mat3f& normals, const cv::Mat1b& mask, const Bake
   dy.setTo(0.0f);
   const double min_nz = options.normal_map.min_nz;
   // A pass with zero weight is skipped, not computed and multiplied by 0.
+  std::vector<detail::SlopePass> passes;
   if (options.alpha < 1.0) {
-    detail::addMaskedGaussianSlopes(normals, mask, options.sigma_fine, min_nz,
-                                    static_cast<float>(1.0 - options.alpha), dx, dy,
-                                    workspace.smoothed);
+    passes.push_back({options.sigma_fine, static_cast<float>(1.0 - options.alpha)});
   }
-  if (options.alpha > 0.0) {
-    detail::addMaskedGaussianSlopes(normals, mask, options.sigma_coarse, min_nz,
-                                    static_cast<float>(options.alpha), dx, dy, workspace.smoothed);
-  }
+  if (options.alpha > 0.0)
+    passes.push_back({options.sigma_coarse, static_cast<float>(options.alpha)});
+  detail::addMaskedGaussianSlopes(normals, mask, passes, min_nz, dx, dy, workspace.smoothing);
   if (options.remove_mean_slope) {
     cv::subtract(dx, cv::mean(dx, mask), dx, mask);
     cv::subtract(dy, cv::mean(dy, mask), dy, mask);
