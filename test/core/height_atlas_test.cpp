@@ -145,16 +145,21 @@ TEST(HeightAtlas, GivenIslandLabelsKeepTouchingIslandsApart) {
 }
 
 TEST(HeightAtlas, RowLookUpEqualsSingleLookUpsBitForBit) {
-  // Random heights on three islands with gaps between them; UVs anywhere (outside [0, 1] too,
+  // Random heights on three islands with gaps between them, and on one island filling the map
+  // (a tiling texture: the look-up reads no interior flags); UVs anywhere (outside [0, 1] too,
   // on texel lines, at the map's edges), some pixels not wanted; both wrap modes.
   cv::RNG rng(7);
   cv::Mat1f heights(37, 53);
   rng.fill(heights, cv::RNG::UNIFORM, -1.0, 1.0);
-  cv::Mat1b valid(heights.size(), 255);
-  valid.colRange(20, 23).setTo(0);
-  valid.rowRange(10, 12).setTo(0);
-  valid(cv::Rect(40, 25, 5, 5)).setTo(0);
-  for (const UvWrap wrap : {UvWrap::kRepeat, UvWrap::kClamp}) {
+  cv::Mat1b islands(heights.size(), 255);
+  islands.colRange(20, 23).setTo(0);
+  islands.rowRange(10, 12).setTo(0);
+  islands(cv::Rect(40, 25, 5, 5)).setTo(0);
+  const cv::Mat1b whole(heights.size(), 255);
+  for (const auto& [valid, wrap] : {std::pair{islands, UvWrap::kRepeat},
+                                    {islands, UvWrap::kClamp},
+                                    {whole, UvWrap::kRepeat},
+                                    {whole, UvWrap::kClamp}}) {
     const HeightAtlas atlas(heights, valid, wrap);
     constexpr int kCount = 4003;  // not a multiple of 4: the scalar tail runs too
     std::vector<cv::Vec2f> uv(kCount);

@@ -125,6 +125,9 @@ class HeightAtlas {
   /// 1 where texel (r, c) and its right, lower and lower-right neighbours are all in one
   /// island: there a look-up is a plain bilinear blend, the common case.
   cv::Mat1b interior_;
+  /// interior_ is 1 everywhere (one island filling the map: a tiling material's texture), so
+  /// look-ups need not read it.
+  bool all_interior_ = false;
   int island_count_ = 0;
   UvWrap wrap_ = UvWrap::kRepeat;
 };

@@ -54,7 +54,9 @@ struct AtlasTexels {
 /// HeightAtlas::sampleFiniteRow eight UVs a step, texels gathered: the same operations in the
 /// same order as sampleFinite(), so the same floats. Lanes whose four texels are not one
 /// island's interior neighbours are listed in `slow` (for sampleFinite); unwanted lanes get 0.
-/// Returns the number of UVs done (a multiple of 8).
+/// Returns the number of UVs done (a multiple of 8). kAllInterior: every texel is an interior
+/// one (atlas.interior unused), so no flag is gathered: a quarter fewer cache lines to load.
+template <bool kAllInterior>
 NORM2TEX_TARGET_AVX2 int sampleInteriorLanesAvx2(const AtlasTexels& atlas, const cv::Vec2f* uv,
                                                  const unsigned char* wanted, int count, float* out,
                                                  int* slow, int& slow_count) {
@@ -94,15 +96,17 @@ NORM2TEX_TARGET_AVX2 int sampleInteriorLanesAvx2(const AtlasTexels& atlas, const
             _mm256_or_si256(_mm256_cmpgt_epi32(zero_int, x0), _mm256_cmpgt_epi32(x0, last_x0)),
             _mm256_or_si256(_mm256_cmpgt_epi32(zero_int, y0), _mm256_cmpgt_epi32(y0, last_y0))),
         want);
-    // The interior flag: a byte, gathered as 32 bits (in bounds: a whole row follows it).
-    const __m256i flag_index = _mm256_add_epi32(_mm256_mullo_epi32(y0, interior_step), x0);
-    const __m256i flags =
-        _mm256_and_si256(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
-                                                     reinterpret_cast<const int*>(atlas.interior),
-                                                     flag_index, inside, 1),
-                         byte);
-    const __m256i fast =
-        _mm256_andnot_si256(_mm256_cmpeq_epi32(flags, _mm256_setzero_si256()), inside);
+    __m256i fast = inside;
+    if (!kAllInterior) {
+      // The interior flag: a byte, gathered as 32 bits (in bounds: a whole row follows it).
+      const __m256i flag_index = _mm256_add_epi32(_mm256_mullo_epi32(y0, interior_step), x0);
+      const __m256i flags =
+          _mm256_and_si256(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(),
+                                                       reinterpret_cast<const int*>(atlas.interior),
+                                                       flag_index, inside, 1),
+                           byte);
+      fast = _mm256_andnot_si256(_mm256_cmpeq_epi32(flags, _mm256_setzero_si256()), inside);
+    }
     const __m256 fast_mask = _mm256_castsi256_ps(fast);
     // Each lane's two neighbours in a row are one 64-bit load: four gathers of four pairs.
     const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(y0, heights_step), x0);
@@ -215,6 +219,7 @@ void HeightAtlas::finish() {
     out[last] =
         row[last] != 0 && row[0] == row[last] && next[last] == row[last] && next[0] == row[last];
   }
+  all_interior_ = cv::countNonZero(interior_) == static_cast<int>(interior_.total());
 }
 void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* wanted, int count,
                                   float* out) const {
@@ -243,7 +248,10 @@ void HeightAtlas::sampleFiniteRow(const cv::Vec2f* uv, const unsigned char* want
     thread_local std::vector<int> slow;
     slow.resize(static_cast<std::size_t>(count));
     int slow_count = 0;
-    i = sampleInteriorLanesAvx2(texels, uv, wanted, count, out, slow.data(), slow_count);
+    i = all_interior_
+            ? sampleInteriorLanesAvx2<true>(texels, uv, wanted, count, out, slow.data(), slow_count)
+            : sampleInteriorLanesAvx2<false>(texels, uv, wanted, count, out, slow.data(),
+                                             slow_count);
     for (int k = 0; k < slow_count; ++k) {
       out[slow[k]] = sampleFinite(uv[slow[k]][0], uv[slow[k]][1]);
     }
@@ -312,7 +320,7 @@ void HeightAtlas::prefetchRow(const cv::Vec2f* uv, int count) const {
     const float* top = heights_.ptr<float>(y0) + x0;
     __builtin_prefetch(top);
     __builtin_prefetch(top + heights_.step1());
-    __builtin_prefetch(interior_.ptr<unsigned char>(y0) + x0);
+    if (!all_interior_) __builtin_prefetch(interior_.ptr<unsigned char>(y0) + x0);
   }
 }
 
