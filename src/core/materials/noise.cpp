@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "norm2tex/common/simd_dispatch.hpp"
+
 namespace norm2tex {
 namespace noise {
 namespace detail {
@@ -17,6 +19,54 @@ const double kGradients[16][2] = {
     {0.1950903220161283, -0.9807852804032304},   {0.5555702330196018, -0.8314696123025455},
     {0.8314696123025452, -0.5555702330196022},   {0.9807852804032303, -0.19509032201612872},
 };
+
+namespace {
+
+NORM2TEX_ALWAYS_INLINE void accumulateBody(int count, const double* __restrict fx,
+                                           const double* __restrict fy, const double* __restrict g,
+                                           double amplitude, double* __restrict sum) {
+  const std::size_t n = static_cast<std::size_t>(count);
+  const double* __restrict g00x = g;
+  const double* __restrict g00y = g + n;
+  const double* __restrict g10x = g + 2 * n;
+  const double* __restrict g10y = g + 3 * n;
+  const double* __restrict g01x = g + 4 * n;
+  const double* __restrict g01y = g + 5 * n;
+  const double* __restrict g11x = g + 6 * n;
+  const double* __restrict g11y = g + 7 * n;
+  for (int i = 0; i < count; ++i) {
+    // blendCorners, written out on the arrays: the same operations in the same order.
+    const double x = fx[i], y = fy[i];
+    const double n00 = g00x[i] * x + g00y[i] * y;
+    const double n10 = g10x[i] * (x - 1.0) + g10y[i] * y;
+    const double n01 = g01x[i] * x + g01y[i] * (y - 1.0);
+    const double n11 = g11x[i] * (x - 1.0) + g11y[i] * (y - 1.0);
+    const double u = fade(x), v = fade(y);
+    const double a = n00 + u * (n10 - n00), b = n01 + u * (n11 - n01);
+    sum[i] += amplitude * (1.4 * (a + v * (b - a)));
+  }
+}
+void accumulateBaseline(int count, const double* fx, const double* fy, const double* g,
+                        double amplitude, double* sum) {
+  accumulateBody(count, fx, fy, g, amplitude, sum);
+}
+#if NORM2TEX_HAS_AVX2_BUILD
+NORM2TEX_TARGET_AVX2 void accumulateAvx2(int count, const double* fx, const double* fy,
+                                         const double* g, double amplitude, double* sum) {
+  accumulateBody(count, fx, fy, g, amplitude, sum);
+}
+using Accumulate = void (*)(int, const double*, const double*, const double*, double, double*);
+const Accumulate accumulate = pickSimd<Accumulate>(accumulateAvx2, accumulateBaseline);
+#else
+const auto accumulate = accumulateBaseline;
+#endif
+
+}  // namespace
+
+void accumulateBlendedCorners(int count, const double* fx, const double* fy, const double* g,
+                              double amplitude, double* sum) {
+  accumulate(count, fx, fy, g, amplitude, sum);
+}
 
 }  // namespace detail
 

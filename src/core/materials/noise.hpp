@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace norm2tex {
 namespace noise {
@@ -205,6 +206,81 @@ inline double fbm2(FbmCache<kOctaves>& cache, std::uint64_t seed, double x, doub
         return o < kOctaves ? gradient2(cache.cell[o], s, xo, yo) : gradient2(s, xo, yo);
       },
       x, y, octaves, gain);
+}
+
+/// Scratch arrays of fbm2Row, kept by the caller (one per thread).
+struct FbmRowScratch {
+  /// g: the points' corner gradients, component after component (00 x, 00 y, 10 x, 10 y, 01 x,
+  /// 01 y, 11 x, 11 y), each an array of all points.
+  std::vector<double> x, y, sum, fx, fy, g;
+};
+
+namespace detail {
+/// sum[i] += amplitude * blendCorners(point i's corners, fx[i], fy[i]), with g[k count + i]
+/// the k-th corner-gradient component of point i (FbmRowScratch::g's order).
+/// Plain loops that vectorise (built for AVX2 and the baseline, noise.cpp); the same operations
+/// as blendCorners, so the same bits.
+void accumulateBlendedCorners(int count, const double* fx, const double* fy, const double* g,
+                              double amplitude, double* sum);
+}  // namespace detail
+
+/// fbm2 of the points (x[i], y) through `cache`: out[i] is fbm2(cache, seed, x[i], y, octaves,
+/// gain), bit for bit. Per octave, the cells and gradients are found point by point (hashes only
+/// where the cell changes) and the blends are done a vector at a time.
+template <int kOctaves>
+void fbm2Row(FbmCache<kOctaves>& cache, std::uint64_t seed, const double* x, double y, int count,
+             int octaves, double gain, double* out, FbmRowScratch& scratch) {
+  if (!cache.seeded || cache.seed != seed) {
+    for (int o = 0; o < kOctaves; ++o) cache.octave_seed[o] = derive(seed, o);
+    cache.seeded = true;
+    cache.seed = seed;
+  }
+  constexpr double kC = 0.8, kS = 0.6;  // as fbm2With
+  const auto n = static_cast<std::size_t>(count);
+  scratch.x.assign(x, x + count);
+  scratch.y.assign(n, y);
+  scratch.sum.assign(n, 0.0);
+  scratch.fx.resize(n);
+  scratch.fy.resize(n);
+  scratch.g.resize(8 * n);
+  double norm = 0.0, amplitude = 1.0;
+  for (int o = 0; o < octaves; ++o) {
+    const std::uint64_t octave_seed = o < kOctaves ? cache.octave_seed[o] : derive(seed, o);
+    GradientCell uncached;
+    GradientCell& cell = o < kOctaves ? cache.cell[o] : uncached;
+    double* xs = scratch.x.data();
+    double* ys = scratch.y.data();
+    for (int i = 0; i < count; ++i) {
+      const std::int64_t ix = floorInt(xs[i]), iy = floorInt(ys[i]);
+      if (!cell.used || cell.ix != ix || cell.iy != iy || cell.seed != octave_seed) {
+        cell.g[0] = detail::cornerGradient(octave_seed, ix, iy);
+        cell.g[1] = detail::cornerGradient(octave_seed, ix + 1, iy);
+        cell.g[2] = detail::cornerGradient(octave_seed, ix, iy + 1);
+        cell.g[3] = detail::cornerGradient(octave_seed, ix + 1, iy + 1);
+        cell.used = true;
+        cell.seed = octave_seed;
+        cell.ix = ix;
+        cell.iy = iy;
+      }
+      scratch.fx[i] = xs[i] - static_cast<double>(ix);
+      scratch.fy[i] = ys[i] - static_cast<double>(iy);
+      double* g = scratch.g.data() + i;
+      for (int k = 0; k < 4; ++k) {
+        g[(2 * k) * n] = cell.g[k][0];
+        g[(2 * k + 1) * n] = cell.g[k][1];
+      }
+    }
+    detail::accumulateBlendedCorners(count, scratch.fx.data(), scratch.fy.data(), scratch.g.data(),
+                                     amplitude, scratch.sum.data());
+    norm += amplitude;
+    amplitude *= gain;
+    for (int i = 0; i < count; ++i) {
+      const double xr = 2.0 * (kC * xs[i] - kS * ys[i]), yr = 2.0 * (kS * xs[i] + kC * ys[i]);
+      xs[i] = xr + 17.31;
+      ys[i] = yr - 5.73;
+    }
+  }
+  for (int i = 0; i < count; ++i) out[i] = norm > 0.0 ? scratch.sum[i] / norm : 0.0;
 }
 
 /// Worley (cellular) noise on a jittered unit lattice: distances to the nearest (f1) and

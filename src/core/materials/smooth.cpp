@@ -110,12 +110,26 @@ class Smooth final : public ProceduralMaterial {
     }
     cv::Mat1f height;
     createWithHugePages(height, size.height, size.width);
+    // base() a row at a time: the same fbm2 values (noise::fbm2Row), blended a vector at once.
+    thread_local noise::FbmCache<2> wave_cache, micro_cache;
+    thread_local noise::FbmRowScratch fbm_scratch;
+    std::vector<double> xw(size.width), xm(size.width), wave(size.width), micro(size.width);
+    const double inv = 1.0 / wavelength_;
+    for (int c = 0; c < size.width; ++c) {
+      const double x = texelX(c, mm_per_texel, origin_mm);
+      xw[c] = x * inv;
+      xm[c] = x * 4.0;
+    }
     for (int r = 0; r < size.height; ++r) {
       const double y = texelY(r, mm_per_texel, origin_mm);
+      noise::fbm2Row(wave_cache, seed_wave_, xw.data(), y * inv, size.width, 2, 0.5, wave.data(),
+                     fbm_scratch);
+      noise::fbm2Row(micro_cache, seed_micro_, xm.data(), y * 4.0, size.width, 2, 0.5, micro.data(),
+                     fbm_scratch);
       const double* scratch = deepest.ptr<double>(r);
       float* row = height.ptr<float>(r);
       for (int c = 0; c < size.width; ++c) {
-        row[c] = static_cast<float>(base(texelX(c, mm_per_texel, origin_mm), y) + scratch[c]);
+        row[c] = static_cast<float>(waviness_ * wave[c] + micro_ * micro[c] + scratch[c]);
       }
     }
     return height;
