@@ -100,19 +100,25 @@ struct GradientCell {
   const double* g[4] = {nullptr, nullptr, nullptr, nullptr};
 };
 
+namespace detail {
+/// Makes `cell` hold cell (ix, iy) of `seed`'s lattice: hashes only when it holds another.
+inline void enterCell(GradientCell& cell, std::uint64_t seed, std::int64_t ix, std::int64_t iy) {
+  if (cell.used && cell.ix == ix && cell.iy == iy && cell.seed == seed) return;
+  cell.g[0] = cornerGradient(seed, ix, iy);
+  cell.g[1] = cornerGradient(seed, ix + 1, iy);
+  cell.g[2] = cornerGradient(seed, ix, iy + 1);
+  cell.g[3] = cornerGradient(seed, ix + 1, iy + 1);
+  cell.used = true;
+  cell.seed = seed;
+  cell.ix = ix;
+  cell.iy = iy;
+}
+}  // namespace detail
+
 /// gradient2 through a cache of its last cell.
 inline double gradient2(GradientCell& cell, std::uint64_t seed, double x, double y) {
   const std::int64_t ix = floorInt(x), iy = floorInt(y);
-  if (!cell.used || cell.ix != ix || cell.iy != iy || cell.seed != seed) {
-    cell.g[0] = detail::cornerGradient(seed, ix, iy);
-    cell.g[1] = detail::cornerGradient(seed, ix + 1, iy);
-    cell.g[2] = detail::cornerGradient(seed, ix, iy + 1);
-    cell.g[3] = detail::cornerGradient(seed, ix + 1, iy + 1);
-    cell.used = true;
-    cell.seed = seed;
-    cell.ix = ix;
-    cell.iy = iy;
-  }
+  detail::enterCell(cell, seed, ix, iy);
   return detail::blendCorners(cell.g, x - static_cast<double>(ix), y - static_cast<double>(iy));
 }
 
@@ -252,16 +258,7 @@ void fbm2Row(FbmCache<kOctaves>& cache, std::uint64_t seed, const double* x, dou
     double* ys = scratch.y.data();
     for (int i = 0; i < count; ++i) {
       const std::int64_t ix = floorInt(xs[i]), iy = floorInt(ys[i]);
-      if (!cell.used || cell.ix != ix || cell.iy != iy || cell.seed != octave_seed) {
-        cell.g[0] = detail::cornerGradient(octave_seed, ix, iy);
-        cell.g[1] = detail::cornerGradient(octave_seed, ix + 1, iy);
-        cell.g[2] = detail::cornerGradient(octave_seed, ix, iy + 1);
-        cell.g[3] = detail::cornerGradient(octave_seed, ix + 1, iy + 1);
-        cell.used = true;
-        cell.seed = octave_seed;
-        cell.ix = ix;
-        cell.iy = iy;
-      }
+      detail::enterCell(cell, octave_seed, ix, iy);
       scratch.fx[i] = xs[i] - static_cast<double>(ix);
       scratch.fy[i] = ys[i] - static_cast<double>(iy);
       double* g = scratch.g.data() + i;
