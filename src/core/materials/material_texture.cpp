@@ -102,20 +102,21 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
   const int islands = static_cast<int>(layout.metres_per_uv.size());
   // Per island its column range per row, merged into the box once per row: a cv::Rect union
   // per texel was 20 ms of a 2048^2 texture.
-  std::vector<cv::Rect> boxes(std::max(islands, 0));
-  std::vector<int> first(boxes.size()), last(boxes.size());
-  std::vector<int> seen;  // islands on the current row
+  std::vector<cv::Rect> boxes(islands);
+  std::vector<int> first(islands), last(islands);
+  std::vector<int> seen;  // islands on the current row, in order of appearance
   for (int r = 0; r < extent.height; ++r) {
     const int* row = layout.island.ptr<int>(r);
     seen.clear();
     for (int c = 0; c < extent.width; ++c) {
       const int id = row[c];
       if (id <= 0 || id >= islands) continue;
-      if (seen.empty() || seen.back() != id) {
-        if (std::find(seen.begin(), seen.end(), id) == seen.end()) {
-          seen.push_back(id);
-          first[id] = c;
-        }
+      // Runs of one island are the rule: the last one seen answers without a search.
+      const bool known = !seen.empty() && (seen.back() == id ||
+                                           std::find(seen.begin(), seen.end(), id) != seen.end());
+      if (!known) {
+        seen.push_back(id);
+        first[id] = c;
       }
       last[id] = c;
     }

@@ -35,15 +35,10 @@ NORM2TEX_ALWAYS_INLINE void accumulateBody(int count, const double* __restrict f
   const double* __restrict g11x = g + 6 * n;
   const double* __restrict g11y = g + 7 * n;
   for (int i = 0; i < count; ++i) {
-    // blendCorners, written out on the arrays: the same operations in the same order.
-    const double x = fx[i], y = fy[i];
-    const double n00 = g00x[i] * x + g00y[i] * y;
-    const double n10 = g10x[i] * (x - 1.0) + g10y[i] * y;
-    const double n01 = g01x[i] * x + g01y[i] * (y - 1.0);
-    const double n11 = g11x[i] * (x - 1.0) + g11y[i] * (y - 1.0);
-    const double u = fade(x), v = fade(y);
-    const double a = n00 + u * (n10 - n00), b = n01 + u * (n11 - n01);
-    sum[i] += amplitude * (1.4 * (a + v * (b - a)));
+    const double c00[2] = {g00x[i], g00y[i]}, c10[2] = {g10x[i], g10y[i]};
+    const double c01[2] = {g01x[i], g01y[i]}, c11[2] = {g11x[i], g11y[i]};
+    const double* const corners[4] = {c00, c10, c01, c11};
+    sum[i] += amplitude * blendCorners(corners, fx[i], fy[i]);
   }
 }
 void accumulateBaseline(int count, const double* fx, const double* fy, const double* g,

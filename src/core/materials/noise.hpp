@@ -160,6 +160,17 @@ inline double gradient1(GradientInterval& interval, std::uint64_t seed, double x
   return detail::blendEnds(interval.g0, interval.g1, x - static_cast<double>(ix));
 }
 
+namespace detail {
+/// The next fBm octave's coordinates: twice the frequency, turned by ~37 deg (cos / sin of a
+/// 3-4-5 triangle: exact in binary, no libm call), offset so octaves share no zero at the origin.
+inline void nextOctave(double& x, double& y) {
+  constexpr double kC = 0.8, kS = 0.6;
+  const double xr = 2.0 * (kC * x - kS * y), yr = 2.0 * (kS * x + kC * y);
+  x = xr + 17.31;
+  y = yr - 5.73;
+}
+}  // namespace detail
+
 /// Fractal Brownian motion of 2-D gradient noise: `octaves` octaves, frequency x2 and
 /// amplitude x`gain` per octave, each octave rotated by ~37 deg (hides the lattice's axes) and
 /// seeded on its own. Normalised by the sum of amplitudes: roughly in [-1, 1].
@@ -167,16 +178,12 @@ inline double gradient1(GradientInterval& interval, std::uint64_t seed, double x
 template <typename Octave, typename Seed>
 inline double fbm2With(const Seed& octave_seed, const Octave& octave, double x, double y,
                        int octaves, double gain) {
-  // cos / sin of 36.87 deg (a 3-4-5 triangle): exact in binary, no libm call.
-  constexpr double kC = 0.8, kS = 0.6;
   double sum = 0.0, norm = 0.0, amplitude = 1.0;
   for (int o = 0; o < octaves; ++o) {
     sum += amplitude * octave(o, octave_seed(o), x, y);
     norm += amplitude;
     amplitude *= gain;
-    const double xr = 2.0 * (kC * x - kS * y), yr = 2.0 * (kS * x + kC * y);
-    x = xr + 17.31;  // offset: octaves do not share a zero at the origin
-    y = yr - 5.73;
+    detail::nextOctave(x, y);
   }
   return norm > 0.0 ? sum / norm : 0.0;
 }
@@ -241,7 +248,6 @@ void fbm2Row(FbmCache<kOctaves>& cache, std::uint64_t seed, const double* x, dou
     cache.seeded = true;
     cache.seed = seed;
   }
-  constexpr double kC = 0.8, kS = 0.6;  // as fbm2With
   const auto n = static_cast<std::size_t>(count);
   scratch.x.assign(x, x + count);
   scratch.y.assign(n, y);
@@ -271,11 +277,7 @@ void fbm2Row(FbmCache<kOctaves>& cache, std::uint64_t seed, const double* x, dou
                                      amplitude, scratch.sum.data());
     norm += amplitude;
     amplitude *= gain;
-    for (int i = 0; i < count; ++i) {
-      const double xr = 2.0 * (kC * xs[i] - kS * ys[i]), yr = 2.0 * (kS * xs[i] + kC * ys[i]);
-      xs[i] = xr + 17.31;
-      ys[i] = yr - 5.73;
-    }
+    for (int i = 0; i < count; ++i) detail::nextOctave(xs[i], ys[i]);
   }
   for (int i = 0; i < count; ++i) out[i] = norm > 0.0 ? scratch.sum[i] / norm : 0.0;
 }
