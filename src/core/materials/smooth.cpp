@@ -118,14 +118,14 @@ class Smooth final : public ProceduralMaterial {
     for (int c = 0; c < size.width; ++c) {
       const double x = texelX(c, mm_per_texel, origin_mm);
       xw[c] = x * inv;
-      xm[c] = x * 4.0;
+      xm[c] = x * kMicroPerMm;
     }
     for (int r = 0; r < size.height; ++r) {
       const double y = texelY(r, mm_per_texel, origin_mm);
       noise::fbm2Row(wave_cache, seed_wave_, xw.data(), y * inv, size.width, 2, 0.5, wave.data(),
                      fbm_scratch);
-      noise::fbm2Row(micro_cache, seed_micro_, xm.data(), y * 4.0, size.width, 2, 0.5, micro.data(),
-                     fbm_scratch);
+      noise::fbm2Row(micro_cache, seed_micro_, xm.data(), y * kMicroPerMm, size.width, 2, 0.5,
+                     micro.data(), fbm_scratch);
       const double* scratch = deepest.ptr<double>(r);
       float* row = height.ptr<float>(r);
       for (int c = 0; c < size.width; ++c) {
@@ -159,12 +159,16 @@ class Smooth final : public ProceduralMaterial {
     seed_scratch_ = noise::derive(seed(), 3);
   }
 
+  /// The micro-roughness noise's lattice cells per mm (its base wavelength 0.25 mm); shared by
+  /// base() and the row render, which must give the same bits.
+  static constexpr double kMicroPerMm = 4.0;
+
   double base(double x, double y) const {
     // Noise look-ups of one thread's last texels (see noise.hpp): same bits, fewer hashes.
     thread_local noise::FbmCache<2> wave, micro;
     const double inv = 1.0 / wavelength_;
     return waviness_ * noise::fbm2(wave, seed_wave_, x * inv, y * inv, 2) +
-           micro_ * noise::fbm2(micro, seed_micro_, x * 4.0, y * 4.0, 2);
+           micro_ * noise::fbm2(micro, seed_micro_, x * kMicroPerMm, y * kMicroPerMm, 2);
   }
 
   /// Calls f(scratch) for every scratch centred in cell (ix, iy): a Poisson number of them.
