@@ -254,6 +254,36 @@ TEST(ObjectTextureCache, BackgroundRunsWhileTheCallerGoesOn) {
   EXPECT_FALSE(cache.preparing());
 }
 
+TEST(ObjectTextureCache, BackgroundIsOneThreadThatKeepsItsScratchAcrossTextures) {
+  // What a preparation leaves in thread-local scratch (TLS buffers, the malloc arena) is there
+  // for the next one: they run on one long-lived thread, not a fresh one each.
+  ObjectTextureCache cache(4);
+  std::vector<int> earlier_on_this_thread;
+  auto preparation = [&](const std::string& key) {
+    return [&earlier_on_this_thread, key] {
+      thread_local int prepared_here = 0;
+      earlier_on_this_thread.push_back(prepared_here++);
+      ObjectTexture texture;
+      texture.description = key;
+      return texture;
+    };
+  };
+  for (const std::string key : {"wood/1", "wood/2", "wood/3"}) {
+    ASSERT_TRUE(cache.prefetch(key, preparation(key)));
+    EXPECT_EQ(cache.get(key, [] { return ObjectTexture{}; }).texture->description, key);
+  }
+  EXPECT_EQ(earlier_on_this_thread, (std::vector<int>{0, 1, 2}));
+}
+
+TEST(ObjectTextureCache, DestructorFinishesAPreparationItWasGiven) {
+  std::atomic<int> count{0};
+  {
+    ObjectTextureCache cache(2);
+    ASSERT_TRUE(cache.prefetch("rock/1", fakePreparation("rock/1", count, 20)));
+  }
+  EXPECT_EQ(count.load(), 1);
+}
+
 TEST(ObjectTextureCache, BackgroundErrorIsThrownByGetAndNotKept) {
   ObjectTextureCache cache(2);
   ASSERT_TRUE(cache.prefetch(

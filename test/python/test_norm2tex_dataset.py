@@ -6,7 +6,6 @@ Usage (catkin passes these): test_norm2tex_dataset.py NORM2TEX_EXPORT_EXECUTABLE
 """
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import tempfile
@@ -21,9 +20,11 @@ EXPORT = sys.argv[1] if len(sys.argv) > 1 else "norm2tex_export"
 
 
 def _free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    # scripts/free_port: below the kernel's ephemeral range, so roslaunch's own server cannot
+    # be handed the same port before its master binds it.
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
+                          "free_port")
+    return int(subprocess.run([script], capture_output=True, text=True, check=True).stdout)
 
 
 class DatasetTest(unittest.TestCase):

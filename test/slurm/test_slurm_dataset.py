@@ -18,9 +18,9 @@ REPO = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file
 
 
 def _free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    # scripts/free_port: below the kernel's ephemeral range (see there).
+    return int(subprocess.run([os.path.join(REPO, "scripts", "free_port")], capture_output=True,
+                              text=True, check=True).stdout)
 
 
 def _run(command, **kwargs):

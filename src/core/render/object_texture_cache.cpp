@@ -20,13 +20,25 @@ ObjectTextureCache::ObjectTextureCache(std::size_t capacity) : capacity_(capacit
 }
 
 ObjectTextureCache::~ObjectTextureCache() {
-  std::unique_ptr<InFlight> pending;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    pending = std::move(in_flight_);
+    stopping_ = true;  // the background still runs a job it was given, then returns
   }
-  // The future of std::async would wait anyway; waiting explicitly keeps the order clear.
-  if (pending) pending->result.wait();
+  job_ready_.notify_all();
+  if (background_.joinable()) background_.join();
+}
+
+void ObjectTextureCache::runBackground() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    job_ready_.wait(lock, [this] { return stopping_ || job_; });
+    if (!job_) return;  // stopping, nothing left to run
+    std::function<void()> job = std::move(job_);
+    job_ = nullptr;
+    lock.unlock();
+    job();  // never throws: the job hands its result or error to a promise
+    lock.lock();
+  }
 }
 
 void ObjectTextureCache::keep(const std::string& key,
@@ -94,11 +106,17 @@ bool ObjectTextureCache::prefetch(const std::string& key, Prepare prepare) {
                   [&](const auto& entry) { return entry.first == key; })) {
     return false;
   }
-  auto task = [prepare = std::move(prepare)]() {
-    return std::shared_ptr<const ObjectTexture>(std::make_shared<ObjectTexture>(prepare()));
+  auto promise = std::make_shared<std::promise<std::shared_ptr<const ObjectTexture>>>();
+  in_flight_ = std::make_unique<InFlight>(InFlight{key, promise->get_future().share()});
+  job_ = [promise, prepare = std::move(prepare)]() {
+    try {
+      promise->set_value(std::make_shared<const ObjectTexture>(prepare()));
+    } catch (...) {
+      promise->set_exception(std::current_exception());
+    }
   };
-  in_flight_ = std::make_unique<InFlight>(
-      InFlight{key, std::async(std::launch::async, std::move(task)).share()});
+  if (!background_.joinable()) background_ = std::thread([this] { runBackground(); });
+  job_ready_.notify_one();
   return true;
 }
 

@@ -1,0 +1,81 @@
+// nodelet_group: a nodelet manager that loads the nodelets listed in its ~nodelets parameter
+// itself, instead of one `nodelet load` client process per nodelet.
+//
+// Why: each client is a ROS node of its own. Under simulated time every node subscribes to
+// /clock, so a recording that publishes /clock per frame sent each tick over TCP to every idle
+// client and woke it up (two threads each) on the two cores the renderer and recorder need.
+// The group is still a full manager: its load_nodelet / unload_nodelet services stay up, so
+// `nodelet load TYPE norm2tex_manager` adds more nodelets to it as usual.
+//
+//   <node pkg="norm2tex" type="nodelet_group" name="norm2tex_manager" required="true">
+//     <rosparam param="nodelets">[{name: probe_sim, type: norm2tex/ProbeSimNodelet}]</rosparam>
+//   </node>
+// Each nodelet reads its parameters from its own private namespace (/probe_sim/...), as when
+// loaded by a client; names are resolved in the group's namespace. ~num_worker_threads as for
+// `nodelet manager`.
+#include <string>
+#include <vector>
+
+#include <nodelet/loader.h>
+#include <ros/ros.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+namespace {
+
+struct NodeletSpec {
+  std::string name, type;
+};
+
+/// ~nodelets as a list of {name, type}; an empty list and the reason when it is malformed.
+std::vector<NodeletSpec> readNodelets(const ros::NodeHandle& pnh, std::string* why) {
+  XmlRpc::XmlRpcValue list;
+  if (!pnh.getParam("nodelets", list) || list.getType() != XmlRpc::XmlRpcValue::TypeArray ||
+      list.size() == 0) {
+    *why = "~nodelets must be a non-empty list of {name: NAME, type: PACKAGE/Type}";
+    return {};
+  }
+  std::vector<NodeletSpec> specs;
+  for (int i = 0; i < list.size(); ++i) {
+    XmlRpc::XmlRpcValue& entry = list[i];
+    if (entry.getType() != XmlRpc::XmlRpcValue::TypeStruct || !entry.hasMember("name") ||
+        !entry.hasMember("type") || entry["name"].getType() != XmlRpc::XmlRpcValue::TypeString ||
+        entry["type"].getType() != XmlRpc::XmlRpcValue::TypeString) {
+      *why = "~nodelets[" + std::to_string(i) + "] is not {name: NAME, type: PACKAGE/Type}";
+      return {};
+    }
+    specs.push_back(
+        {static_cast<std::string>(entry["name"]), static_cast<std::string>(entry["type"])});
+  }
+  return specs;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "nodelet_group");
+  ros::NodeHandle pnh("~");
+  std::string why;
+  const std::vector<NodeletSpec> specs = readNodelets(pnh, &why);
+  if (specs.empty()) {
+    ROS_FATAL("nodelet_group: %s", why.c_str());
+    return 1;
+  }
+  // With the manager's services (and its ~num_worker_threads workers), like `nodelet manager`.
+  nodelet::Loader loader(true);
+  for (const NodeletSpec& spec : specs) {
+    const std::string name = ros::names::resolve(spec.name);
+    // A nodelet whose start-up failed stops the node (ros::shutdown, with a FATAL saying why):
+    // the ones after it are not loaded.
+    if (!ros::ok()) return 1;
+    if (!loader.load(name, spec.type, nodelet::M_string(), nodelet::V_string())) {
+      ROS_FATAL(
+          "nodelet_group: could not load %s of type %s (is the type in a nodelet plugin "
+          "description, and its package built?)",
+          name.c_str(), spec.type.c_str());
+      return 1;
+    }
+  }
+  ros::spin();
+  // The loader's destructor unloads the nodelets (a recorder closes its bag) before exit.
+  return 0;
+}
