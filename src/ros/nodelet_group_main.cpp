@@ -64,16 +64,15 @@ int main(int argc, char** argv) {
   nodelet::Loader loader(true);
   for (const NodeletSpec& spec : specs) {
     const std::string name = ros::names::resolve(spec.name);
-    // A nodelet whose start-up failed stops the node (ros::shutdown, with a FATAL saying why):
-    // the ones after it are not loaded.
-    if (!ros::ok()) return 1;
     if (!loader.load(name, spec.type, nodelet::M_string(), nodelet::V_string())) {
-      ROS_FATAL(
-          "nodelet_group: could not load %s of type %s (is the type in a nodelet plugin "
-          "description, and its package built?)",
-          name.c_str(), spec.type.c_str());
+      ROS_FATAL("nodelet_group: could not load %s of type %s (is the type in a nodelet plugin "
+                "description, and its package built?)",
+                name.c_str(), spec.type.c_str());
       return 1;
     }
+    // A nodelet whose start-up failed stopped the node (ros::shutdown, after a FATAL saying
+    // why): the ones after it are not loaded, and the group exits non-zero.
+    if (!ros::ok()) return 1;
   }
   ros::spin();
   // The loader's destructor unloads the nodelets (a recorder closes its bag) before exit.

@@ -429,6 +429,42 @@ TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
   }
 }
 
+TEST(BadRendererInput, NodeletGroupStartUpErrorsExitNonZeroNamingTheCause) {
+  // nodelet_group reads its list from ~nodelets (a YAML list: set here, not on the command
+  // line); a nodelet that fails to start ends the group with its own FATAL.
+  ros::param::set("/group_bad_renderer/material", std::string("unobtainium"));
+  auto entry = [](const std::string& name, const std::string& type) {
+    XmlRpc::XmlRpcValue value;
+    value["name"] = name;
+    if (!type.empty()) value["type"] = type;
+    return value;
+  };
+  XmlRpc::XmlRpcValue no_type, unknown_type, failing, empty;
+  no_type[0] = entry("group_a", "");
+  unknown_type[0] = entry("group_b", "norm2tex/NoSuchNodelet");
+  failing[0] = entry("group_bad_renderer", "norm2tex/TactileRendererNodelet");
+  empty.setSize(0);
+  struct Case {
+    std::string node;
+    const XmlRpc::XmlRpcValue* nodelets;  // null: no ~nodelets at all
+    std::string expected;
+  } cases[] = {
+      {"group_without_list", nullptr, "~nodelets must be a non-empty list"},
+      {"group_with_empty_list", &empty, "~nodelets must be a non-empty list"},
+      {"group_without_type", &no_type, "~nodelets[0] is not {name: NAME, type: PACKAGE/Type}"},
+      {"group_unknown_type", &unknown_type, "norm2tex/NoSuchNodelet"},
+      {"group_failing_nodelet", &failing, "unobtainium"},
+  };
+  for (const Case& c : cases) {
+    if (c.nodelets != nullptr) ros::param::set("/" + c.node + "/nodelets", *c.nodelets);
+    std::string output;
+    const int status = norm2tex::test::runCommand(
+        std::string(NORM2TEX_NODELET_GROUP_EXECUTABLE) + " __name:=" + c.node, output);
+    EXPECT_EQ(status, 1) << c.node << ":\n" << output;
+    EXPECT_NE(output.find(c.expected), std::string::npos) << c.node << ":\n" << output;
+  }
+}
+
 TEST(BadRendererInput, APoseThatNeverArrivesIsCountedNotFaked) {
   // digit_ghost renders a frame that has no TF: every frame is reported missing, no image is
   // published for it, and the renderer stays up.
