@@ -65,9 +65,10 @@ int main(int argc, char** argv) {
   for (const NodeletSpec& spec : specs) {
     const std::string name = ros::names::resolve(spec.name);
     if (!loader.load(name, spec.type, nodelet::M_string(), nodelet::V_string())) {
-      ROS_FATAL("nodelet_group: could not load %s of type %s (is the type in a nodelet plugin "
-                "description, and its package built?)",
-                name.c_str(), spec.type.c_str());
+      ROS_FATAL(
+          "nodelet_group: could not load %s of type %s (is the type in a nodelet plugin "
+          "description, and its package built?)",
+          name.c_str(), spec.type.c_str());
       return 1;
     }
     // A nodelet whose start-up failed stopped the node (ros::shutdown, after a FATAL saying
