@@ -50,7 +50,6 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
   pnh.param("shard", p.shard, p.shard);
   if (p.shard < 0) badParameter("shard", text(p.shard), ">= 0");
   pnh.param("sensors", p.sensors, p.sensors);
-  pnh.param("sensors", p.sensors, p.sensors);
   p.topics = {"/tf", "/tf_static", "/joint_states", "/clock", "episode"};
   for (const std::string& sensor : p.sensors) p.topics.push_back(sensor + "/background");
   pnh.param("topics", p.topics, p.topics);
