@@ -3,16 +3,11 @@
 // itself, and the bags are read back. Every frame is a contact with its labels; a seed
 // reproduces its images bit for bit (nodelets or nodes); another seed probes elsewhere; two
 // shards are disjoint and together give the unsharded dataset; the export round-trips.
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
-#include <cstdint>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -31,27 +26,14 @@ namespace norm2tex {
 namespace {
 namespace fs = std::filesystem;
 
-/// A TCP port nobody listens on now, for this run's own master: below the kernel's ephemeral
-/// range, as scripts/free_port picks it (roslaunch's own server takes an ephemeral port before
-/// the master binds its port, and could be handed the same one).
+/// A TCP port nobody listens on now, for this run's own master: from scripts/free_port, below
+/// the kernel's ephemeral range (roslaunch's own server takes an ephemeral port before the
+/// master binds its port, and could be handed the same one).
 int freePort() {
-  int ephemeral_low = 32768;
-  std::ifstream range("/proc/sys/net/ipv4/ip_local_port_range");
-  range >> ephemeral_low;
-  static std::mt19937 random(static_cast<unsigned>(getpid()) ^ static_cast<unsigned>(time(nullptr)));
-  for (int attempt = 0; attempt < 200 && ephemeral_low > 11000; ++attempt) {
-    const int port = std::uniform_int_distribution<int>(10000, ephemeral_low - 1)(random);
-    const int s = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    address.sin_port = htons(static_cast<std::uint16_t>(port));
-    const bool free = bind(s, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0;
-    close(s);
-    if (free) return port;
-  }
-  ADD_FAILURE() << "no free port below " << ephemeral_low;
-  return 11311;
+  std::string output;
+  EXPECT_EQ(test::runCommand(std::string(NORM2TEX_SOURCE_DIR) + "/scripts/free_port", output), 0)
+      << output;
+  return std::stoi(output);
 }
 
 const fs::path& scratch() {
