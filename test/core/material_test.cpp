@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -238,6 +239,45 @@ TEST(Material, GridEvaluationEqualsPerPoint) {
   }
   expectError([] { makeMaterial("wood")->renderHeightMm({0, 4}, 0.05); }, {"size"});
   expectError([] { makeMaterial("wood")->renderHeightMm({4, 4}, 0.0); }, {"mm_per_texel"});
+}
+
+TEST(Material, Print3dRowKernelGivesTheTexelsBits) {
+  // print3d renders its grid through a row kernel (chunks of 256 texels, cells and hashes point
+  // by point, arithmetic a vector at a time). Against heightMm texel by texel, bit for bit:
+  // rows wider than a chunk with a partial last chunk, layers at an angle, strong wobble and
+  // per-layer variation, a fine pitch (many layers per chunk), a negative origin, and every
+  // shipped variant's parameters.
+  struct Case {
+    const char* what;
+    std::unique_ptr<ProceduralMaterial> material;
+  };
+  std::vector<Case> cases;
+  auto tilted = makeMaterial("print3d");
+  tilted->setParameter("layer_angle_deg", 37.0);
+  tilted->setParameter("layer_variation", 0.9);
+  tilted->setParameter("layer_pitch_mm", 0.06);
+  tilted->setParameter("infill_spacing_mm", 0.7);
+  tilted->setSeed(23);
+  cases.push_back({"tilted", std::move(tilted)});
+  const MaterialConfig config = loadMaterialConfig(configPath("print3d"));
+  for (int k = 0; k < config.variant_count; k += 5) {
+    cases.push_back({"variant", makeMaterialVariant(config, k, 0)});
+  }
+  const cv::Size size(600, 7);
+  const double mm_per_texel = 0.0123;
+  const cv::Point2d origin(-3.31, -1.07);
+  for (const Case& c : cases) {
+    const cv::Mat1f height = c.material->renderHeightMm(size, mm_per_texel, origin);
+    int mismatches = 0;
+    for (int r = 0; r < size.height; ++r) {
+      for (int col = 0; col < size.width; ++col) {
+        const float h = static_cast<float>(c.material->heightMm(
+            origin.x + (col + 0.5) * mm_per_texel, origin.y + (r + 0.5) * mm_per_texel));
+        if (std::memcmp(&h, &height(r, col), sizeof(float)) != 0) ++mismatches;
+      }
+    }
+    EXPECT_EQ(mismatches, 0) << c.what << " of " << size.area();
+  }
 }
 
 TEST(Noise, CachedLookUpsGiveTheUncachedBits) {
