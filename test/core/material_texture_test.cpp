@@ -131,5 +131,45 @@ TEST(MaterialTexture, BakedMaterialAtlasFitsAMeshWithoutUvs) {
   EXPECT_GE(atlas.islandCount(), 6) << "one island per box face at least";
 }
 
+TEST(MaterialTexture, AtlasOnAMeshWithUvsHasTheMaterialsResolution) {
+  // The shipped cube: 30 mm faces, UVs repeating every 20 mm (20 mm per UV unit).
+  const TexturedMesh cube = makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02);
+  MaterialConfig config;
+  config.name = "print3d";
+  struct Case {
+    double mm_per_texel;
+    int size, expected;
+  };
+  // 20 mm / 1024 = 0.0195 <= 0.025 < 20 mm / 512 = 0.039: print3d and smooth at 1024; wood,
+  // fabric and rock (0.05 mm) at 512; a finer material keeps the cap; halvings of a size that
+  // is not a power of two.
+  for (const Case c : {Case{0.025, 2048, 1024}, Case{0.05, 1024, 512}, Case{0.05, 2048, 512},
+                       Case{0.005, 2048, 2048}, Case{0.0195312, 2048, 2048},
+                       Case{0.0195313, 2048, 1024}, Case{1.0, 2048, 32}, Case{0.025, 1000, 1000}}) {
+    config.mm_per_texel = c.mm_per_texel;
+    config.size = c.size;
+    const int size = materialAtlasSize(config, cube);
+    EXPECT_EQ(size, c.expected) << c.mm_per_texel << " mm, size " << c.size;
+    // The defining property: texels no larger than mm_per_texel unless capped at size, and the
+    // next halving would be coarser.
+    if (size < c.size) EXPECT_LE(20.0 / size, c.mm_per_texel);
+    if (size / 2 >= 16) EXPECT_GT(20.0 / (size / 2), c.mm_per_texel);
+  }
+  // A larger UV period needs more texels for the same resolution.
+  config.mm_per_texel = 0.025;
+  config.size = 4096;
+  EXPECT_EQ(materialAtlasSize(config, makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.08)), 4096);
+  // Without UVs the automatic atlas is packed for config.size: that size is kept.
+  const TexturedMesh no_uvs(cube.vertices(), cube.triangles());
+  EXPECT_EQ(materialAtlasSize(config, no_uvs), 4096);
+  // The bake follows it.
+  config.mm_per_texel = 0.05;
+  config.size = 256;
+  TexturedMesh mesh = makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.004);  // 4 mm per UV unit
+  const HeightAtlas atlas = bakeMaterialAtlas(config, 3, mesh);
+  EXPECT_EQ(atlas.rows(), 128);  // 4 mm / 128 = 0.031 <= 0.05 < 4 mm / 64 = 0.0625
+  EXPECT_EQ(atlas.cols(), 128);
+}
+
 }  // namespace
 }  // namespace norm2tex

@@ -34,11 +34,22 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, int si
 MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const UvLayout& layout,
                                       int depth, int padding_texels, bool with_albedo = true);
 
+/// The side, in texels, of a material's atlas on `mesh`: the smallest of config.size,
+/// config.size / 2, config.size / 4, ... (down to 16) whose texels are no larger than
+/// config.mm_per_texel on the mesh's most stretched UV island. The material's stated resolution,
+/// and no finer: finer texels cost time in every bake and cache misses in every frame, and show
+/// nothing a DIGIT resolves (0.053 mm/pixel). E.g. the 30 mm cube (its UVs repeat every 20 mm):
+/// print3d and smooth (0.025 mm) get 1024 (0.0195 mm/texel), wood, fabric and rock (0.05 mm)
+/// 512 (0.039 mm/texel); at a fixed 2048 the cube had 0.0098 mm/texel. config.size when the
+/// mesh has no UVs (its automatic atlas is packed for config.size) or when even config.size is
+/// coarser than mm_per_texel.
+int materialAtlasSize(const MaterialConfig& config, const TexturedMesh& mesh);
+
 /// H_global of a material as it lies on `mesh`, ready for the TextureOverlay: the material
 /// (variant `variant` of the config, see makeMaterialVariant; `seed`) rendered for the mesh's UV
-/// layout at config.size texels, encoded as a 16-bit normal map and baked with config.range,
-/// exactly as a user's normal map file would be. A mesh without UVs is replaced by its unwrapped
-/// copy first (so `mesh` may change).
+/// layout at materialAtlasSize texels, encoded as a 16-bit normal map and baked with
+/// config.range, exactly as a user's normal map file would be. A mesh without UVs is replaced by
+/// its unwrapped copy first (so `mesh` may change).
 HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, TexturedMesh& mesh,
                               int padding_texels = 4, int variant = 0);
 

@@ -153,8 +153,22 @@ MaterialTexture renderMaterialTexture(const ProceduralMaterial& material, const 
   return texture;
 }
 
+int materialAtlasSize(const MaterialConfig& config, const TexturedMesh& mesh) {
+  if (!mesh.hasUvs()) return config.size;
+  // metres per UV unit does not depend on the raster: a tiny layout gives it.
+  const UvLayout layout = computeUvLayout(mesh, cv::Size(16, 16));
+  const double mm_per_uv =
+      1e3 * *std::max_element(layout.metres_per_uv.begin(), layout.metres_per_uv.end());
+  if (!(mm_per_uv > 0.0)) return config.size;  // no UV area: nothing to scale by
+  int size = config.size;
+  while (size / 2 >= 16 && mm_per_uv / (size / 2) <= config.mm_per_texel) size /= 2;
+  return size;
+}
+
 HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, TexturedMesh& mesh,
                               int padding_texels, int variant) {
+  // Before unwrapping: an automatic atlas is packed (padding included) for config.size.
+  const int size = materialAtlasSize(config, mesh);
   if (!mesh.hasUvs()) {
     UnwrapOptions options;
     options.texture_size = config.size;
@@ -163,8 +177,8 @@ HeightAtlas bakeMaterialAtlas(const MaterialConfig& config, std::uint64_t seed, 
   }
   const auto material = makeMaterialVariant(config, variant, seed);
   const MaterialTexture texture =
-      renderMaterialTexture(*material, computeUvLayout(mesh, cv::Size(config.size, config.size)),
-                            CV_16U, padding_texels, /*with_albedo=*/false);
+      renderMaterialTexture(*material, computeUvLayout(mesh, cv::Size(size, size)), CV_16U,
+                            padding_texels, /*with_albedo=*/false);
   BakeOptions options;
   options.range = config.range;
   // No relief high-pass: a procedural normal map is the exact slope of a designed height, so

@@ -262,16 +262,25 @@ void fbm2Row(FbmCache<kOctaves>& cache, std::uint64_t seed, const double* x, dou
     GradientCell& cell = o < kOctaves ? cache.cell[o] : uncached;
     double* xs = scratch.x.data();
     double* ys = scratch.y.data();
-    for (int i = 0; i < count; ++i) {
+    double* fx = scratch.fx.data();
+    double* fy = scratch.fy.data();
+    double* g = scratch.g.data();
+    // Run by run of points in one cell: the cell's gradients stay in registers while they are
+    // written out (point by point they were reloaded through the cache, 3x slower).
+    for (int i = 0; i < count;) {
       const std::int64_t ix = floorInt(xs[i]), iy = floorInt(ys[i]);
       detail::enterCell(cell, octave_seed, ix, iy);
-      scratch.fx[i] = xs[i] - static_cast<double>(ix);
-      scratch.fy[i] = ys[i] - static_cast<double>(iy);
-      double* g = scratch.g.data() + i;
-      for (int k = 0; k < 4; ++k) {
-        g[(2 * k) * n] = cell.g[k][0];
-        g[(2 * k + 1) * n] = cell.g[k][1];
-      }
+      const double corner[8] = {cell.g[0][0], cell.g[0][1], cell.g[1][0], cell.g[1][1],
+                                cell.g[2][0], cell.g[2][1], cell.g[3][0], cell.g[3][1]};
+      // floorInt(v) == i exactly when i <= v < i + 1: comparisons, not conversions, per point.
+      const double cx = static_cast<double>(ix), cy = static_cast<double>(iy);
+      const double cx_end = cx + 1.0, cy_end = cy + 1.0;
+      do {
+        fx[i] = xs[i] - cx;
+        fy[i] = ys[i] - cy;
+        for (int k = 0; k < 8; ++k) g[k * n + i] = corner[k];
+        ++i;
+      } while (i < count && xs[i] >= cx && xs[i] < cx_end && ys[i] >= cy && ys[i] < cy_end);
     }
     detail::accumulateBlendedCorners(count, scratch.fx.data(), scratch.fy.data(), scratch.g.data(),
                                      amplitude, scratch.sum.data());

@@ -54,7 +54,8 @@ ObjectTexture loadObjectTexture(const TextureSource& source, TexturedMesh& mesh)
         bakeMaterialAtlas(config, source.seed, mesh, 4, source.variant));
     out.beta_mm = config.beta_mm;
     out.description = "material " + config.name + " variant " + std::to_string(source.variant) +
-                      " seed " + std::to_string(source.seed);
+                      " seed " + std::to_string(source.seed) + ", " +
+                      std::to_string(out.atlas->cols()) + "^2 atlas";
     return out;
   }
   return loadTextureFile(source, mesh);
