@@ -1,11 +1,17 @@
 // Materials on meshes: the relief keeps its millimetre scale on every UV island, padding.
 #include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/materials/material_texture.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
+#include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/render/tactile_renderer.hpp"
 #include "norm2tex/texture/normal_map.hpp"
 
 namespace norm2tex {
@@ -169,6 +175,71 @@ TEST(MaterialTexture, AtlasOnAMeshWithUvsHasTheMaterialsResolution) {
   const HeightAtlas atlas = bakeMaterialAtlas(config, 3, mesh);
   EXPECT_EQ(atlas.rows(), 128);  // 4 mm / 128 = 0.031 <= 0.05 < 4 mm / 64 = 0.0625
   EXPECT_EQ(atlas.cols(), 128);
+}
+
+TEST(MaterialTexture, TheMaterialsResolutionShowsTheSameTextureAsTwiceIt) {
+  // What materialAtlasSize leaves out must not show in a DIGIT image: print3d on the shipped
+  // cube at its own resolution (1024, 0.0195 mm/texel) against twice it (2048, as before the
+  // rule). The texture's part of the image (textured minus textureless) agrees: same strength,
+  // same fine detail (Laplacian), strongly correlated (the two bakes sample the material at
+  // different points, so not identical). Measured: correlation 0.91, RMS 0.33 vs 0.31 grey
+  // levels, Laplacian RMS 1.29 vs 1.25; an atlas of 256 (0.078 mm/texel, coarser than a pixel)
+  // against 2048 fails: correlation 0.62, RMS 0.40 vs 0.31.
+  MaterialConfig config =
+      loadMaterialConfig(std::string(NORM2TEX_SOURCE_DIR) + "/config/materials/print3d.yaml");
+  TexturedMesh cube = loadObjectMesh("box:30x30x30", 1.0).mesh;
+  ASSERT_EQ(materialAtlasSize(config, cube), 1024);
+  const auto own = std::make_shared<HeightAtlas>(bakeMaterialAtlas(config, 0, cube));
+  MaterialConfig finer = config;
+  finer.mm_per_texel /= 2;
+  ASSERT_EQ(materialAtlasSize(finer, cube), 2048);
+  const auto twice = std::make_shared<HeightAtlas>(bakeMaterialAtlas(finer, 0, cube));
+  ASSERT_EQ(own->cols(), 1024);
+  ASSERT_EQ(twice->cols(), 2048);
+
+  const auto mesh = std::make_shared<const TexturedMesh>(cube);
+  // A face pressed 1 mm into the gel, tilted, turned: layers cross the image at an angle.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) *
+                   Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()) *
+                   Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitX()))
+                      .toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(0.003, 0.002, 0.014);
+  const auto textureOf = [&](std::shared_ptr<const HeightAtlas> atlas) {
+    TactileRenderer renderer(makeDigitSensorModel());
+    renderer.setObject(mesh, nullptr, 0.0);
+    const auto grey = [](const cv::Mat3b& image) {
+      cv::Mat grey_8u;
+      cv::cvtColor(image, grey_8u, cv::COLOR_BGR2GRAY);
+      cv::Mat1f out;
+      grey_8u.convertTo(out, CV_32F);
+      return out;
+    };
+    const cv::Mat1f flat = grey(renderer.render(pose, -1).image);
+    renderer.setObject(mesh, std::move(atlas), config.beta_mm);
+    const TactileFrame& frame = renderer.render(pose, -1);
+    EXPECT_GT(cv::countNonZero(frame.contact_mask), 20000);
+    return cv::Mat1f(grey(frame.image) - flat);
+  };
+  const cv::Mat1f a = textureOf(own), b = textureOf(twice);
+  const auto rms = [](const cv::Mat1f& m) { return std::sqrt(cv::mean(m.mul(m))[0]); };
+  const auto laplacian = [](const cv::Mat1f& m) {
+    cv::Mat1f out;
+    cv::Laplacian(m, out, CV_32F);
+    return out;
+  };
+  cv::Scalar mean_a, sd_a, mean_b, sd_b;
+  cv::meanStdDev(a, mean_a, sd_a);
+  cv::meanStdDev(b, mean_b, sd_b);
+  const double correlation = cv::mean((a - mean_a[0]).mul(b - mean_b[0]))[0] / (sd_a[0] * sd_b[0]);
+  EXPECT_GT(rms(b), 0.05) << "the texture shows";
+  EXPECT_GT(correlation, 0.8);
+  EXPECT_NEAR(rms(a) / rms(b), 1.0, 0.15);
+  EXPECT_NEAR(rms(laplacian(a)) / rms(laplacian(b)), 1.0, 0.15);
+  std::printf(
+      "texture at 1024 vs 2048: correlation %.3f, RMS %.3f vs %.3f, Laplacian RMS %.3f vs "
+      "%.3f grey levels\n",
+      correlation, rms(a), rms(b), rms(laplacian(a)), rms(laplacian(b)));
 }
 
 }  // namespace
