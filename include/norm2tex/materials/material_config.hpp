@@ -6,8 +6,8 @@
 #include <string>
 #include <utility>
 
-#include "norm2tex/texture/height_range.hpp"
 #include "norm2tex/materials/procedural_material.hpp"
+#include "norm2tex/texture/height_range.hpp"
 
 namespace norm2tex {
 
@@ -18,9 +18,11 @@ struct MaterialConfig {
   double beta_mm = 0.1;  ///< texture depth: H_final = H_sensor + beta H_local
   HeightRange range = HeightRange::kSymmetric;  ///< normalisation range of H_global
   double friction = 0.5;                        ///< Coulomb friction coefficient for the physics
-  double mm_per_texel = 0.05;                   ///< default texture resolution
-  int size = 1024;                              ///< default texture size, texels (square)
-  std::map<std::string, double> parameters;     ///< overrides of the material's defaults
+  double mm_per_texel = 0.05;  ///< texture resolution: the largest texel, mm on the surface
+  /// Texture size, texels (square): a flat texture's, and the largest atlas on a mesh (see
+  /// materialAtlasSize).
+  int size = 1024;
+  std::map<std::string, double> parameters;  ///< overrides of the material's defaults
   /// Per parameter: [low, high] from which variants draw it uniformly (integers for integer
   /// parameters). Must lie inside the parameter's valid range.
   std::map<std::string, std::pair<double, double>> variant_ranges;
