@@ -28,7 +28,7 @@ struct ProbeScene {
     auto cube = std::make_shared<norm2tex::TexturedMesh>(
         norm2tex::loadObjectMesh("box:30x30x30", 1.0).mesh);
     atlas = std::make_shared<const norm2tex::HeightAtlas>(
-        norm2tex::bakeMaterialAtlas(config, 0, *cube, 4, 1));  // unwraps the cube
+        norm2tex::bakeMaterialAtlas(config, 0, *cube, 4, 1));  // on the cube's UVs, as the dataset
     mesh = cube;
     norm2tex::ProbeScenario scenario(*mesh, norm2tex::ProbeConfig{}, sensor, 0);
     for (std::uint64_t press = 0; frames.size() < 2000; ++press) {
