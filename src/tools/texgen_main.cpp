@@ -43,8 +43,10 @@ constexpr const char* kUsage =
     "  size and mm per texel) come from config/materials/NAME.yaml; --param overrides one\n"
     "  parameter (see --list for names, units and ranges).\n"
     "  --mesh: a texture for that mesh. With UVs, every UV island gets the relief at its own\n"
-    "  millimetre scale; without, the mesh is unwrapped into a new atlas and written to\n"
-    "  --out-mesh (default: NORMAL_mesh.obj) with a material that references NORMAL.png.\n"
+    "  millimetre scale, in the atlas the nodes use (the smallest of size, size/2, ... whose\n"
+    "  texels are at most mm per texel on the mesh; --size forces a size); without, the mesh\n"
+    "  is unwrapped into a new atlas of size texels and written to --out-mesh (default:\n"
+    "  NORMAL_mesh.obj) with a material that references NORMAL.png.\n"
     "  --variants K: K variants drawn from the config's variant ranges, NAME_NN_normal.png and\n"
     "  NAME_NN_albedo.png in DIR with variants.yaml listing their parameters.\n";
 
@@ -239,9 +241,15 @@ int run(int argc, char** argv) {
     }();
     const int padding = args.integer("--padding", 4);
     if (mesh.hasUvs()) {
+      // The atlas the nodes generate for this mesh (materialAtlasSize), unless --size says.
+      norm2tex::MaterialConfig for_mesh = config;
+      for_mesh.mm_per_texel = mm_per_texel;
+      const int atlas_size =
+          args.has("--size") ? size : norm2tex::materialAtlasSize(for_mesh, mesh);
       texture = norm2tex::renderMaterialTexture(
-          *material, norm2tex::computeUvLayout(mesh, cv::Size(size, size)), depth, padding);
-      mesh_note = ", on the mesh's own UVs";
+          *material, norm2tex::computeUvLayout(mesh, cv::Size(atlas_size, atlas_size)), depth,
+          padding);
+      mesh_note = ", on the mesh's own UVs, " + std::to_string(atlas_size) + "^2 texels";
     } else {
       norm2tex::UnwrapOptions unwrap;
       unwrap.texture_size = size;

@@ -123,6 +123,21 @@ TEST_F(TexgenCli, MeshWithoutUvsIsUnwrappedAndWrittenWithItsNormalMap) {
   EXPECT_LT(island_texels, 256 * 256) << "with padding around them";
 }
 
+TEST_F(TexgenCli, MeshWithUvsGetsTheAtlasTheNodesUse) {
+  // The shipped cube's UVs repeat every 20 mm: print3d (0.025 mm a texel, size 2048) gets 1024
+  // texels (0.0195 mm), as bakeMaterialAtlas gives the nodes; --size forces a size.
+  norm2tex::saveMesh(norm2tex::makeBox(Eigen::Vector3d(0.03, 0.03, 0.03), 0.02), path("cube.obj"));
+  const CliRun run =
+      texgen("--material print3d --mesh " + path("cube.obj") + " -o " + path("cube_normal.png"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("1024^2 texels"), std::string::npos) << run.output;
+  EXPECT_EQ(cv::imread(path("cube_normal.png"), cv::IMREAD_UNCHANGED).size(), cv::Size(1024, 1024));
+  const CliRun forced = texgen("--material print3d --size 256 --mesh " + path("cube.obj") + " -o " +
+                               path("cube_256.png"));
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_EQ(cv::imread(path("cube_256.png"), cv::IMREAD_UNCHANGED).size(), cv::Size(256, 256));
+}
+
 TEST_F(TexgenCli, VariantsAreFilesPlusAManifest) {
   const CliRun run = texgen("--material smooth --size 64 --variants 3 --out-dir " + path("v"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
