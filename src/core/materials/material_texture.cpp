@@ -1,6 +1,7 @@
 #include "norm2tex/materials/material_texture.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
@@ -157,9 +158,10 @@ int materialAtlasSize(const MaterialConfig& config, const TexturedMesh& mesh) {
   if (!mesh.hasUvs()) return config.size;
   // metres per UV unit does not depend on the raster: a tiny layout gives it.
   const UvLayout layout = computeUvLayout(mesh, cv::Size(16, 16));
-  const double mm_per_uv =
-      1e3 * *std::max_element(layout.metres_per_uv.begin(), layout.metres_per_uv.end());
-  if (!(mm_per_uv > 0.0)) return config.size;  // no UV area: nothing to scale by
+  double mm_per_uv = 0.0;
+  for (const double metres : layout.metres_per_uv) mm_per_uv = std::max(mm_per_uv, 1e3 * metres);
+  // No UV area (nothing to scale by) or a degenerate island (infinite): keep size.
+  if (!(mm_per_uv > 0.0) || !std::isfinite(mm_per_uv)) return config.size;
   int size = config.size;
   while (size / 2 >= 16 && mm_per_uv / (size / 2) <= config.mm_per_texel) size /= 2;
   return size;
