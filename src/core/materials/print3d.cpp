@@ -199,7 +199,7 @@ class Print3d final : public ProceduralMaterial {
       for (int c0 = 0; c0 < size.width; c0 += kChunk) {
         const int count = std::min(kChunk, size.width - c0);
         for (int i = 0; i < count; ++i) x[i] = texelX(c0 + i, mm_per_texel, origin_mm);
-        heightChunk(p_, caches, x, y, count, row + c0);
+        heightChunk(layers_, caches, x, y, count, row + c0);
       }
     }
     return image;
@@ -223,31 +223,31 @@ class Print3d final : public ProceduralMaterial {
   };
 
   void update() override {
-    p_.pitch = value(kPitch);
+    layers_.pitch = value(kPitch);
     const double angle = value(kAngle) * kDegToRad;
-    p_.cos = std::cos(angle);
-    p_.sin = std::sin(angle);
-    p_.depth = value(kDepth);
-    p_.variation = value(kVariation);
-    p_.infill_amplitude = value(kInfillAmplitude);
-    p_.infill_spacing = value(kInfillSpacing);
+    layers_.cos = std::cos(angle);
+    layers_.sin = std::sin(angle);
+    layers_.depth = value(kDepth);
+    layers_.variation = value(kVariation);
+    layers_.infill_amplitude = value(kInfillAmplitude);
+    layers_.infill_spacing = value(kInfillSpacing);
     const double phi = value(kInfillAngle) * kDegToRad;
     // Normals (across directions) of the two infill line families at angle +-phi.
-    p_.n1x = -std::sin(angle + phi);
-    p_.n1y = std::cos(angle + phi);
-    p_.n2x = -std::sin(angle - phi);
-    p_.n2y = std::cos(angle - phi);
-    p_.seed_wobble = noise::derive(seed(), 1);
-    p_.seed_layer = noise::derive(seed(), 2);
+    layers_.n1x = -std::sin(angle + phi);
+    layers_.n1y = std::cos(angle + phi);
+    layers_.n2x = -std::sin(angle - phi);
+    layers_.n2y = std::cos(angle - phi);
+    layers_.seed_wobble = noise::derive(seed(), 1);
+    layers_.seed_layer = noise::derive(seed(), 2);
     // Where the infill lines fall depends on the part: a random phase per family.
     const std::uint64_t infill = noise::derive(seed(), 3);
-    p_.phase1 = noise::unit(infill);
-    p_.phase2 = noise::unit(noise::mix64(infill));
+    layers_.phase1 = noise::unit(infill);
+    layers_.phase2 = noise::unit(noise::mix64(infill));
   }
 
   /// One texel; heightChunkBody is the same arithmetic for a row.
   Sample evaluate(double x, double y, Caches& caches) const {
-    const Layers& p = p_;
+    const Layers& p = layers_;
     const double u = p.cos * x + p.sin * y;   // along the layers
     const double v = -p.sin * x + p.cos * y;  // across (build direction)
     // The nozzle's path wanders slightly: layer lines wobble by up to a quarter pitch.
@@ -273,7 +273,7 @@ class Print3d final : public ProceduralMaterial {
     return s;
   }
 
-  Layers p_;
+  Layers layers_;
 };
 
 }  // namespace
