@@ -147,16 +147,22 @@ struct GradientInterval {
   double g0 = 0.0, g1 = 0.0;
 };
 
+namespace detail {
+/// Makes `interval` hold interval ix of `seed`'s lattice: hashes only when it holds another.
+inline void enterInterval(GradientInterval& interval, std::uint64_t seed, std::int64_t ix) {
+  if (interval.used && interval.ix == ix && interval.seed == seed) return;
+  interval.g0 = gradientAt(seed, ix);
+  interval.g1 = gradientAt(seed, ix + 1);
+  interval.used = true;
+  interval.seed = seed;
+  interval.ix = ix;
+}
+}  // namespace detail
+
 /// gradient1 through a cache of its last interval.
 inline double gradient1(GradientInterval& interval, std::uint64_t seed, double x) {
   const std::int64_t ix = floorInt(x);
-  if (!interval.used || interval.ix != ix || interval.seed != seed) {
-    interval.g0 = detail::gradientAt(seed, ix);
-    interval.g1 = detail::gradientAt(seed, ix + 1);
-    interval.used = true;
-    interval.seed = seed;
-    interval.ix = ix;
-  }
+  detail::enterInterval(interval, seed, ix);
   return detail::blendEnds(interval.g0, interval.g1, x - static_cast<double>(ix));
 }
 

@@ -105,17 +105,10 @@ NORM2TEX_ALWAYS_INLINE void heightChunkBody(const Layers& p, Caches& caches,
     floored[i] = static_cast<double>(n);
     const std::uint64_t layer = layerHash(p, caches, n);
     layer_unit[i] = noise::unit(layer);
-    noise::GradientInterval& interval = caches.bulge;
     const std::int64_t ix = noise::floorInt(wx[i]);
-    if (!interval.used || interval.ix != ix || interval.seed != layer) {
-      interval.g0 = noise::detail::gradientAt(layer, ix);
-      interval.g1 = noise::detail::gradientAt(layer, ix + 1);
-      interval.used = true;
-      interval.seed = layer;
-      interval.ix = ix;
-    }
-    bulge_g0[i] = interval.g0;
-    bulge_g1[i] = interval.g1;
+    noise::detail::enterInterval(caches.bulge, layer, ix);
+    bulge_g0[i] = caches.bulge.g0;
+    bulge_g1[i] = caches.bulge.g1;
     bulge_f[i] = wx[i] - static_cast<double>(ix);
   }
   // The infill lines' coordinates, then their floors (floorInt: no libm call).
