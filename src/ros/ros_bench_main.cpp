@@ -15,6 +15,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
+#include "norm2tex/SimFrame.h"
 #include "norm2tex/Step.h"
 #include "wait_for.hpp"
 
@@ -23,8 +24,10 @@ namespace {
 using norm2tex::waitFor;
 
 struct Arrivals {
-  std::map<ros::Time, int> count;           // images per stamp (both sensors)
-  std::map<ros::Time, ros::WallTime> last;  // when the stamp's last image arrived
+  std::map<ros::Time, int> count;            // images per stamp (both sensors)
+  std::map<ros::Time, ros::WallTime> first;  // when the stamp's first image arrived
+  std::map<ros::Time, ros::WallTime> last;   // when the stamp's last image arrived
+  std::map<ros::Time, ros::WallTime> frame;  // when its SimFrame arrived (physics done)
   int total = 0;
 };
 
@@ -52,8 +55,9 @@ int main(int argc, char** argv) {
   Arrivals arrivals;
   auto on_image = [&](const sensor_msgs::Image::ConstPtr& m) {
     ++arrivals.total;
-    ++arrivals.count[m->header.stamp];
-    arrivals.last[m->header.stamp] = ros::WallTime::now();
+    const ros::WallTime now = ros::WallTime::now();
+    if (++arrivals.count[m->header.stamp] == 1) arrivals.first[m->header.stamp] = now;
+    arrivals.last[m->header.stamp] = now;
   };
   // Room for every image of a run: a benchmark that drops images at its own queue would
   // measure itself.
@@ -63,6 +67,16 @@ int main(int argc, char** argv) {
       nh.subscribe<sensor_msgs::Image>("digit_left/image_raw", queue, on_image, {}, hints);
   ros::Subscriber right =
       nh.subscribe<sensor_msgs::Image>("digit_right/image_raw", queue, on_image, {}, hints);
+  // Real time: when each frame's physics was done (its SimFrame here), to split the latency.
+  ros::Subscriber frames_sub;
+  if (mode == "real_time") {
+    frames_sub = nh.subscribe<norm2tex::SimFrame>(
+        "contact_sim/frame", queue,
+        [&](const norm2tex::SimFrame::ConstPtr& f) {
+          arrivals.frame[f->header.stamp] = ros::WallTime::now();
+        },
+        {}, hints);
+  }
   if (!waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60)) {
     std::fprintf(stderr, "norm2tex_ros_bench: no image publishers within 60 s\n");
     return 1;
@@ -108,8 +122,8 @@ int main(int argc, char** argv) {
             seen = arrivals.total;
             last_arrival = now;
           }
-          return called && (arrivals.total - before == 2 * frames ||
-                            (now - last_arrival).toSec() > 2.0);
+          return called &&
+                 (arrivals.total - before == 2 * frames || (now - last_arrival).toSec() > 2.0);
         },
         120);
     caller.join();
@@ -129,7 +143,7 @@ int main(int argc, char** argv) {
   arrivals = Arrivals{};
   waitFor([&] { return static_cast<int>(arrivals.count.size()) >= frames + 2; },
           frames / 30.0 + 30);
-  std::vector<double> latency_ms;
+  std::vector<double> latency_ms, physics_ms, first_ms, second_ms;
   int incomplete = 0;
   // The oldest frame may have had its first image before counting started, the newest its
   // second still on the way when counting stopped: neither is a frame with one image.
@@ -141,6 +155,10 @@ int main(int argc, char** argv) {
       continue;
     }
     latency_ms.push_back(1e3 * (arrivals.last[stamp].toSec() - stamp.toSec()));
+    first_ms.push_back(1e3 * (arrivals.first[stamp].toSec() - stamp.toSec()));
+    second_ms.push_back(1e3 * (arrivals.last[stamp] - arrivals.first[stamp]).toSec());
+    const auto f = arrivals.frame.find(stamp);
+    if (f != arrivals.frame.end()) physics_ms.push_back(1e3 * (f->second.toSec() - stamp.toSec()));
   }
   if (latency_ms.size() < 10) return fail("fewer than 10 frames with both images");
   std::printf(
@@ -148,5 +166,12 @@ int main(int argc, char** argv) {
       "max %.2f ms; %d frames with one image\n",
       latency_ms.size(), percentile(latency_ms, 0.5), percentile(latency_ms, 0.99),
       percentile(latency_ms, 1.0), incomplete);
+  if (physics_ms.size() >= 10) {
+    std::printf(
+        "  of which: stamp -> SimFrame here (physics) p50 %.2f / p99 %.2f ms; stamp -> first "
+        "image p50 %.2f / p99 %.2f ms; first -> second image p50 %.2f / p99 %.2f ms\n",
+        percentile(physics_ms, 0.5), percentile(physics_ms, 0.99), percentile(first_ms, 0.5),
+        percentile(first_ms, 0.99), percentile(second_ms, 0.5), percentile(second_ms, 0.99));
+  }
   return 0;
 }
