@@ -18,6 +18,7 @@
 #include "norm2tex/calibrate/fit_quality.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/render/digit_shader_noise.hpp"
 #include "norm2tex/render/digit_shader_response.hpp"
 #include "norm2tex/render/gel_model.hpp"
 #include "test_helpers.hpp"
@@ -224,6 +225,33 @@ TEST_F(ShaderTest, OutsideTheContactBoxTheFrameIsExactlyTheNoContactFrame) {
   cv::cvtColor(shader.shadingDifference(h) != 0.0f, changed, cv::COLOR_BGR2GRAY);
   EXPECT_EQ(cv::countNonZero(changed & ~touched), 0);
   EXPECT_GT(cv::countNonZero(changed), 100);
+}
+
+// The frame is the background plus the shading difference and the noise, each pixel's float
+// sum rounded half to even and saturated: what OpenCV's mixed-type add gives. The shader's own
+// loop must agree bit for bit, at steep rims that saturate too (the reference adds the noise of
+// the same seed, from DigitShaderNoise).
+TEST_F(ShaderTest, FrameIsTheBackgroundPlusTheRoundedDifferenceAndNoise) {
+  const cv::Mat1f h = smoothed(sphericalCap(model, 3.0, 1.2, -1.0, 2.0), model, 0.2);
+  const cv::Mat3f diff = shader.shadingDifference(h);
+  ASSERT_GT(cv::norm(diff, cv::NORM_INF), 20.0);  // a press that shows
+  cv::Mat3b expected;
+  cv::add(background, diff, expected, cv::noArray(), CV_8U);
+  EXPECT_TRUE(identical(shader.shade(h, -1), expected));
+
+  cv::Mat3f noise;
+  DigitShaderNoise(model.noise).generate(h.size(), 17, noise);
+  cv::add(background, noise + diff, expected, cv::noArray(), CV_8U);
+  EXPECT_TRUE(identical(shader.shade(h, 17), expected));
+
+  // Saturation at both ends: a background near 0 and 255 under the same press.
+  cv::Mat3b extremes(background.size(), cv::Vec3b(2, 128, 253));
+  const DigitShader extreme_shader(model, extremes, kSynthetic);
+  cv::add(extremes, diff, expected, cv::noArray(), CV_8U);
+  const cv::Mat3b shaded = extreme_shader.shade(h, -1);
+  EXPECT_TRUE(identical(shaded, expected));
+  EXPECT_GT(cv::countNonZero(shaded.reshape(1) == 0), 0);
+  EXPECT_GT(cv::countNonZero(shaded.reshape(1) == 255), 0);
 }
 
 // --- shading ---------------------------------------------------------------------------------

@@ -52,6 +52,37 @@ inline cv::Vec3f shadePixel(float dzdx, float dzdy, const cv::Vec3f* lights,
   return result;
 }
 
+/// out[i] = background[i] + round(a[i] (+ b[i])), the float rounded half to even and the sum
+/// saturated to 0..255: what cv::add(background, a, out, noArray(), CV_8U) computes (it rounds
+/// the float operand to int32 first), without its conversions of whole rows. With b, a + b is
+/// summed in float first (the diff added into the noise, then the noise to the background).
+void addToBackground(const uchar* background, const float* a, const float* b, uchar* out, int n) {
+  int i = 0;
+  constexpr int kStep = cv::v_uint8x16::nlanes;
+  for (; i + kStep <= n; i += kStep) {
+    cv::v_uint16x8 bg16[2];
+    cv::v_expand(cv::v_load(background + i), bg16[0], bg16[1]);
+    cv::v_int16x8 rounded16[2];
+    for (int half = 0; half < 2; ++half) {
+      cv::v_uint32x4 bg32[2];
+      cv::v_expand(bg16[half], bg32[0], bg32[1]);
+      cv::v_int32x4 rounded[2];
+      for (int quarter = 0; quarter < 2; ++quarter) {
+        const int at = i + 8 * half + 4 * quarter;
+        cv::v_float32x4 add = cv::v_load(a + at);
+        if (b != nullptr) add = add + cv::v_load(b + at);
+        rounded[quarter] = cv::v_round(add) + cv::v_reinterpret_as_s32(bg32[quarter]);
+      }
+      rounded16[half] = cv::v_pack(rounded[0], rounded[1]);  // saturating
+    }
+    cv::v_store(out + i, cv::v_pack_u(rounded16[0], rounded16[1]));  // saturating
+  }
+  for (; i < n; ++i) {
+    const float add = b != nullptr ? a[i] + b[i] : a[i];
+    out[i] = cv::saturate_cast<uchar>(static_cast<int>(background[i]) + cvRound(add));
+  }
+}
+
 }  // namespace
 
 DigitShader::DigitShader(const SensorModel& model, cv::Mat3b background, BackgroundSource source)
@@ -257,22 +288,43 @@ cv::Mat3b DigitShader::shade(const cv::Mat1f& h_final_mm, std::int64_t noise_see
     diff = diff_scratch(cv::Rect(0, 0, box.width, box.height));
     shadeBox(h_final_mm, box, diff);
   }
-  cv::Mat3b image;
-  background_.copyTo(image);
+  cv::Mat3b image(background_.size());
+  const int width = background_.cols;
   if (noise_seed < 0 || !addsNoise()) {
-    // background + diff, rounded and saturated (OpenCV's vectorised mixed-type add).
-    if (!box.empty()) {
-      cv::Mat out = image(box);
-      cv::add(background_(box), diff, out, cv::noArray(), CV_8U);
+    // background + diff in the box, rounded and saturated; the background elsewhere.
+    for (int r = 0; r < image.rows; ++r) {
+      const uchar* background = background_.ptr<uchar>(r);
+      uchar* out = image.ptr<uchar>(r);
+      if (r < box.y || r >= box.y + box.height) {
+        std::copy_n(background, 3 * width, out);
+        continue;
+      }
+      std::copy_n(background, 3 * box.x, out);
+      addToBackground(background + 3 * box.x, diff.ptr<float>(r - box.y), nullptr, out + 3 * box.x,
+                      3 * box.width);
+      const int right = 3 * (box.x + box.width);
+      std::copy_n(background + right, 3 * width - right, out + right);
     }
     return image;
   }
   // The noise covers the whole frame, independent of the box: a pixel's noise depends only on
-  // the seed and its position.
+  // the seed and its position. Background + (noise + diff), rounded and saturated.
   thread_local cv::Mat3f noise;  // reused per thread, like diff_scratch
   noise_.generate(image.size(), static_cast<std::uint64_t>(noise_seed), noise);
-  if (!box.empty()) noise(box) += diff;
-  cv::add(background_, noise, image, cv::noArray(), CV_8U);
+  for (int r = 0; r < image.rows; ++r) {
+    const uchar* background = background_.ptr<uchar>(r);
+    const float* row_noise = noise.ptr<float>(r);
+    uchar* out = image.ptr<uchar>(r);
+    if (r < box.y || r >= box.y + box.height) {
+      addToBackground(background, row_noise, nullptr, out, 3 * width);
+      continue;
+    }
+    const int left = 3 * box.x, right = 3 * (box.x + box.width);
+    addToBackground(background, row_noise, nullptr, out, left);
+    addToBackground(background + left, row_noise + left, diff.ptr<float>(r - box.y), out + left,
+                    right - left);
+    addToBackground(background + right, row_noise + right, nullptr, out + right, 3 * width - right);
+  }
   return image;
 }
 

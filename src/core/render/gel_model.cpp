@@ -68,9 +68,10 @@ cv::Rect deformationBox(const cv::Mat1f& field) {
 }
 
 /// out = keep ? a : b for one row; both sides read, so it compiles to vector blends, not to a
-/// branch per pixel.
-void selectRow(const uchar* __restrict keep, const float* __restrict a, const float* __restrict b,
-               float* __restrict out, int count) {
+/// branch per pixel. out may be a or b (the callers update a row in place), so no __restrict
+/// on them: each element is read before it is written.
+void selectRow(const uchar* __restrict keep, const float* a, const float* b, float* out,
+               int count) {
   for (int c = 0; c < count; ++c) {
     const float from_a = a[c], from_b = b[c];
     out[c] = keep[c] ? from_a : from_b;
@@ -116,8 +117,11 @@ void blurAroundDeformation(double sigma_px, cv::Mat1f& field, const cv::Mat1b* c
   box.height += 2 * kernel.height;
   box &= cv::Rect(0, 0, field.cols, field.rows);
   if (core == nullptr) {
+    // In place, the border replicated from the box itself (as from a copy of it): OpenCV's
+    // filter reads a row into its ring buffer before it writes the rows that need it.
     cv::Mat1f region = field(box);
-    cv::GaussianBlur(region.clone(), region, kernel, sigma_px, sigma_px, cv::BORDER_REPLICATE);
+    cv::GaussianBlur(region, region, kernel, sigma_px, sigma_px,
+                     cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
     return;
   }
   const cv::Rect written = outsideCoreBox(*core, box);
@@ -191,8 +195,10 @@ void GelModel::apply(const cv::Mat1f& indentation_mm, cv::Mat1f& out) const {
   } else if (current_factor > 1) {
     cv::resize(current, out, indentation_mm.size(), 0, 0, cv::INTER_LINEAR);
     restoreCore(indentation_mm, core, out);
-  } else {
+  } else if (out.isSubmatrix()) {
     current.copyTo(out);
+  } else {
+    out = current;  // the finest level is the result: taken over, not copied
   }
 
   // The bending blur at full resolution, only where the gel moved.
