@@ -149,8 +149,10 @@ int main(int argc, char** argv) {
   // Real time: stamps are wall time (use_sim_time false).
   waitFor([&] { return arrivals.total >= 2 * 60; }, 30);
   arrivals = Arrivals{};
-  waitFor([&] { return static_cast<int>(arrivals.count.size()) >= frames + 2; },
-          frames / 30.0 + 30);
+  // Woken by each image (as a subscriber spinning its queue is), not by a 0.5 ms poll: 2000
+  // wake-ups a second of its own would compete with the renderers it measures.
+  waitFor([&] { return static_cast<int>(arrivals.count.size()) >= frames + 2; }, frames / 30.0 + 30,
+          /*poll_seconds=*/0.1);
   std::vector<double> latency_ms, physics_ms, first_ms, second_ms;
   int incomplete = 0;
   // The oldest frame may have had its first image before counting started, the newest its
