@@ -96,6 +96,15 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
   std::vector<std::string> topics = params_.topics;
   for (const std::string& topic : topics) {
     const std::string resolved = nh_.resolveName(topic);
+    if (endsWith(topic, "/background")) {
+      // Typed: roscpp before 1.15.10 (Debian 11) does not deliver a latched message published
+      // in the same nodelet manager to a ShapeShifter subscriber; a typed one gets it.
+      subs_.push_back(nh_.subscribe<sensor_msgs::Image>(
+          topic, 10, [this, resolved](const ros::MessageEvent<sensor_msgs::Image const>& e) {
+            onLatchedImage(resolved, e);
+          }));
+      continue;
+    }
     subs_.push_back(nh_.subscribe<topic_tools::ShapeShifter>(
         topic, 1000, [this, resolved](const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
           onMessage(resolved, e);
@@ -237,6 +246,13 @@ void DatasetRecorder::onMessage(const std::string& topic,
     return;
   }
   if (params_.split_mb > 0.0 && bag_->getSize() > params_.split_mb * 1e6) openNextBag();
+}
+
+void DatasetRecorder::onLatchedImage(const std::string& topic,
+                                     const ros::MessageEvent<sensor_msgs::Image const>& e) {
+  write(topic, [&](const ros::Time& when) {
+    bag_->write(topic, when, e.getConstMessage(), e.getConnectionHeaderPtr());
+  });
 }
 
 void DatasetRecorder::onFramePart(const std::string& topic, const ros::Time& stamp,

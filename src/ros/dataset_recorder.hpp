@@ -10,6 +10,7 @@
 
 #include <ros/ros.h>
 #include <rosbag/bag.h>
+#include <sensor_msgs/Image.h>
 #include <topic_tools/shape_shifter.h>
 
 #include "norm2tex/EpisodeInfo.h"
@@ -68,6 +69,9 @@ class DatasetRecorder {
   bool write(const std::string& topic, const std::function<void(const ros::Time&)>& write_message);
   /// Extra topics (TF, clock, joints, labels), as they come.
   void onMessage(const std::string& topic, const ros::MessageEvent<topic_tools::ShapeShifter>& e);
+  /// The sensors' no-contact frames (latched), subscribed typed.
+  void onLatchedImage(const std::string& topic,
+                      const ros::MessageEvent<sensor_msgs::Image const>& e);
   /// The sensors' per-frame topics: written, then counted towards their frame (`stamp`).
   void onFramePart(const std::string& topic, const ros::Time& stamp,
                    const std::function<void(const ros::Time&)>& write_message);

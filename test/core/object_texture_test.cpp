@@ -365,28 +365,44 @@ TEST(ObjectTextureCache, RealMaterialPreparedInTheBackgroundEqualsOneMadeInPlace
 namespace norm2tex {
 namespace {
 
+// glibc's heap figures: mallinfo2 (size_t fields) arrived in glibc 2.33; Ubuntu 20.04 and
+// Debian 11 have 2.31, whose mallinfo has int fields, wide enough for these tests' sizes.
+struct HeapFigures {
+  std::size_t mapped;        // hblkhd: bytes in blocks mapped on their own
+  std::size_t free_in_heap;  // fordblks: free bytes kept in the heap
+};
+
+HeapFigures heapFigures() {
+#if __GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 33)
+  const auto info = mallinfo2();
+#else
+  const auto info = mallinfo();
+#endif
+  return {static_cast<std::size_t>(info.hblkhd), static_cast<std::size_t>(info.fordblks)};
+}
+
 TEST(MemoryReuse, FreedTextureSizedBlocksStayInTheHeapForTheNextOne) {
   // A 1024^2 float texture is 4 MB: by default glibc maps such a block fresh and unmaps it on
   // free, so the next texture faults every page in again.
   ASSERT_TRUE(keepFreedMemoryForReuse());
   const std::size_t size = 4u << 20;
-  const std::size_t mapped_before = mallinfo2().hblkhd;
+  const std::size_t mapped_before = heapFigures().mapped;
   void* block = std::malloc(size);
   ASSERT_NE(block, nullptr);
   std::memset(block, 1, size);
-  EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "the block was mapped, not taken from the heap";
+  EXPECT_EQ(heapFigures().mapped, mapped_before) << "the block was mapped, not taken from the heap";
   std::free(block);
-  EXPECT_GE(mallinfo2().fordblks, size) << "the freed block went back to the kernel";
+  EXPECT_GE(heapFigures().free_in_heap, size) << "the freed block went back to the kernel";
   // A 2048^2 texture's 16-bit BGRA normal map is 32 MB: at glibc's largest mmap threshold, so
   // it must not be mapped either.
   const std::size_t large = 32u << 20;
   void* big = std::malloc(large);
   ASSERT_NE(big, nullptr);
   std::memset(big, 1, large);
-  EXPECT_EQ(mallinfo2().hblkhd, mapped_before)
+  EXPECT_EQ(heapFigures().mapped, mapped_before)
       << "the 32 MB block was mapped, not taken from the heap";
   std::free(big);
-  EXPECT_GE(mallinfo2().fordblks, large) << "the freed 32 MB block went back to the kernel";
+  EXPECT_GE(heapFigures().free_in_heap, large) << "the freed 32 MB block went back to the kernel";
 }
 
 }  // namespace

@@ -8,6 +8,8 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
+#ifdef NORM2TEX_BENCHMARK_HAS_SHUTDOWN  // Google Benchmark >= 1.5.3
   benchmark::Shutdown();
+#endif
   return 0;
 }
