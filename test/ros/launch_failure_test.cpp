@@ -103,6 +103,21 @@ TEST(LaunchFailure, AMissingFileEndsTheLaunchAtOnceWithTheReason) {
       << map_run.output;
 }
 
+TEST(LaunchFailure, ANodeletThatFailsAtStartUpEndsTheLaunchWithoutWaitingForTheOthers) {
+  // A mistake only the recorder sees (its compression), loaded after probe_sim, which waits
+  // for its renderers: the manager used to sit out probe_sim's ~ready_timeout (60 s) first.
+  // roslaunch's own status stays 0 here (a required node died; roslaunch 1.15 does not pass
+  // statuses on), so the reason is what the output must carry.
+  const LaunchRun run = launch("record_dataset.launch samples:=10 compression:=zip out:=" +
+                               (scratch() / "zip").string());
+  EXPECT_LT(run.seconds, 15.0) << run.output;
+  EXPECT_NE(run.output.find("~compression = 'zip' is not valid; valid: lz4, bz2, none"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("REQUIRED process [norm2tex_manager"), std::string::npos)
+      << run.output;
+}
+
 TEST(LaunchEnd, AFinishedRecordingEndsTheLaunchQuietly) {
   const fs::path out = scratch() / "recording";
   const LaunchRun run =
