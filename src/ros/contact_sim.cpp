@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include <ros/package.h>
@@ -20,6 +21,7 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "params.hpp"
 
@@ -51,7 +53,14 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   if (!(p.scale > 0.0 && p.scale <= 1000.0)) badParameter("scale", text(p.scale), "(0, 1000]");
   pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
   pnh.param<std::string>("material", p.material, "wood");
-  p.material_config = materialConfigPath(p.material);
+  if (p.material.empty()) p.material = ros_params::kNoMaterial;
+  if (p.material != ros_params::kNoMaterial) {
+    p.material_config = materialConfigPath(p.material, ", or none (then ~friction)");
+  }
+  pnh.param("friction", p.friction, p.friction);
+  if (!(p.friction < 0.0 || p.friction <= 5.0) || std::isnan(p.friction)) {
+    badParameter("friction", text(p.friction), "[0, 5], or < 0 for the material's");
+  }
   int seed = 0;
   pnh.param("seed", seed, 0);
   if (seed < 0) badParameter("seed", text(seed), ">= 0");
@@ -78,8 +87,15 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
 ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readContactSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
   keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
-  const MaterialConfig material = loadMaterialConfig(params_.material_config);
-  beta_mm_ = params_.beta >= 0.0 ? params_.beta : material.beta_mm;
+  std::optional<MaterialConfig> material;
+  if (!params_.material_config.empty()) material = loadMaterialConfig(params_.material_config);
+  // The labels say what the renderers draw: a material's beta, or a texture file's default.
+  beta_mm_ = params_.beta >= 0.0 ? params_.beta
+             : material          ? material->beta_mm
+                                 : kFileTextureBetaMm;
+  const double friction = params_.friction >= 0.0 ? params_.friction
+                          : material              ? material->friction
+                                                  : kDefaultFriction;
   const SensorModel sensor = loadSensorModel(params_.sensor);
   GripperSimConfig config = loadGripperSimConfig(params_.scene);
   if (!params_.mesh.empty()) {
@@ -87,7 +103,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     config.object.scale = params_.scale;
     config.object.name = std::filesystem::path(params_.mesh).stem().string();
   }
-  config.object.friction = material.friction;
+  config.object.friction = friction;
   config.object.material = params_.material;
   setGelFromSensor(sensor, config);
   // Whole physics ticks per sensor frame, so every frame's stamp is a physics state.
@@ -147,7 +163,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
       "contact_sim: %s mode, scene %s, material %s (friction %.2f), physics %.0f Hz "
       "(%d ticks per %.1f Hz frame), object '%s' %s",
       params_.synchronous ? "synchronous" : "real-time", params_.scene.c_str(),
-      params_.material.c_str(), material.friction, config.physics.rate_hz, ticks_per_frame_,
+      params_.material.c_str(), friction, config.physics.rate_hz, ticks_per_frame_,
       params_.frame_rate, config.object.name.c_str(), config.object.mesh.c_str());
 }
 
@@ -191,16 +207,20 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   return info;
 }
 
+void ContactSim::applyCommandOrThrow(const GripperCommand& command) {
+  if (command.mode == GripperCommand::ABSOLUTE) {
+    sim_->setOpening(command.opening);
+  } else if (command.mode == GripperCommand::DELTA) {
+    sim_->addOpening(command.opening);
+  } else {
+    throw Error("gripper command mode " + std::to_string(command.mode) +
+                " is not valid; valid: 0 (ABSOLUTE), 1 (DELTA)");
+  }
+}
+
 bool ContactSim::applyCommand(const GripperCommand& command) {
   try {
-    if (command.mode == GripperCommand::ABSOLUTE) {
-      sim_->setOpening(command.opening);
-    } else if (command.mode == GripperCommand::DELTA) {
-      sim_->addOpening(command.opening);
-    } else {
-      throw Error("gripper command mode " + std::to_string(command.mode) +
-                  " is not valid; valid: 0 (ABSOLUTE), 1 (DELTA)");
-    }
+    applyCommandOrThrow(command);
     return true;
   } catch (const Error& e) {
     ROS_WARN_THROTTLE(1.0, "contact_sim: command rejected, nothing changed: %s", e.what());
@@ -215,28 +235,51 @@ void ContactSim::onCommand(const GripperCommand::ConstPtr& msg) {
 
 bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // Refusals and failures reach the caller as success = false and the reason (a service that
+  // returns false sends its caller no text); the log says it too.
   if (request.seed < 0) {
-    ROS_WARN("contact_sim: ~reset seed %ld rejected; valid: >= 0", static_cast<long>(request.seed));
-    return false;
+    response.success = false;
+    response.message = "~reset seed " + std::to_string(request.seed) + " refused; valid: >= 0";
+    ROS_WARN("contact_sim: %s", response.message.c_str());
+    return true;
   }
   try {
     response.info = startEpisode(request.seed, request.height_offset);
     publishFrame();
     lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
-    ROS_WARN("contact_sim: ~reset failed: %s", e.what());
-    return false;
+    response.success = false;
+    response.message = std::string("~reset refused: ") + e.what();
+    ROS_WARN("contact_sim: %s", response.message.c_str());
+    return true;
   }
+  response.success = true;
   return true;
 }
 
 bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
   std::lock_guard<std::mutex> lock(mutex_);
+  auto fail = [&](const std::string& message) {
+    response.success = false;
+    response.message = message;
+    response.opening = sim_->opening();
+    response.dropped = sim_->dropped();
+    return true;
+  };
   if (request.frames < 1 || request.frames > 100000) {
-    ROS_WARN("contact_sim: ~step frames = %u rejected; valid: [1, 100000]", request.frames);
-    return false;
+    const std::string message =
+        "~step frames = " + std::to_string(request.frames) + " refused; valid: [1, 100000]";
+    ROS_WARN("contact_sim: %s", message.c_str());
+    return fail(message);
   }
-  if (request.set_command && !applyCommand(request.command)) return false;
+  if (request.set_command) {
+    try {
+      applyCommandOrThrow(request.command);
+    } catch (const Error& e) {
+      ROS_WARN("contact_sim: ~step refused, nothing changed: %s", e.what());
+      return fail(std::string("~step refused, nothing changed: ") + e.what());
+    }
+  }
   response.missing_images = 0;
   try {
     for (std::uint32_t i = 0; i < request.frames; ++i) {
@@ -248,8 +291,9 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
     response.missing_images += lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
     ROS_ERROR("contact_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
-    return false;
+    return fail("~step failed at frame " + std::to_string(frame_) + ": " + e.what());
   }
+  response.success = true;
   response.stamp = frameStamp();
   response.opening = sim_->opening();
   response.dropped = sim_->dropped();
@@ -258,6 +302,7 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
 
 ContactSim::~ContactSim() {
   stop_clock_ = true;
+  if (lock_step_) lock_step_->cancel();  // a ~step or ~reset may be waiting for the renderers
   if (clock_thread_.joinable()) clock_thread_.join();
   service_queue_.disable();  // wakes its spinner at once instead of at its next 0.1 s poll
   if (service_spinner_) service_spinner_->stop();

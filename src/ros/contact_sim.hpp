@@ -29,8 +29,13 @@ struct ContactSimParams {
   std::string mesh;              ///< ~mesh: replaces the scene's object mesh when set
   double scale = 1.0;            ///< ~scale of ~mesh (0.001 for millimetres)
   std::string sensor;            ///< ~sensor: sensor yaml (gel size and thickness)
-  std::string material;          ///< ~material: config/materials/<material>.yaml gives the friction
-  std::string material_config;   ///< the yaml resolved from ~material
+  /// ~material: config/materials/<material>.yaml gives the friction and beta; "none": no
+  /// material (the renderers use a texture file or the mesh's own texture)
+  std::string material;
+  std::string material_config;   ///< the yaml resolved from ~material; "" for none
+  /// ~friction: Coulomb coefficient against the gels; < 0: the material's (kDefaultFriction
+  /// with ~material none)
+  double friction = -1.0;
   std::int64_t seed = 0;         ///< ~seed: seed of the first episode
   double height_offset = 0;      ///< ~height_offset [m] of the first episode, NaN = random
   double physics_rate = 1000.0;  ///< ~physics_rate [Hz], rounded to whole ticks per frame
@@ -49,6 +54,9 @@ struct ContactSimParams {
   /// frames are answered (1 = strict lock-step within a step too).
   int window = 2;
 };
+
+/// Friction against the gels with ~material none and no ~friction (the scene default's).
+constexpr double kDefaultFriction = 0.5;
 
 /// Reads and validates the private parameters; throws Error naming the parameter and its valid
 /// range (or the file) at fault.
@@ -75,6 +83,8 @@ class ContactSim {
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
   bool applyCommand(const GripperCommand& command);
+  /// Applies a command; throws Error naming what is wrong (and changes nothing) when invalid.
+  void applyCommandOrThrow(const GripperCommand& command);
   EpisodeInfo startEpisode(std::int64_t seed, double height_offset);
   /// Advances one sensor frame of physics and publishes it.
   void advanceFrame();

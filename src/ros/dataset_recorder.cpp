@@ -13,6 +13,7 @@
 
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
+#include "norm2tex/common/output_directory.hpp"
 #include "params.hpp"
 
 namespace norm2tex {
@@ -28,15 +29,6 @@ struct MessageTag {
 
 bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-/// Free space (MB) for an unprivileged writer on the file system holding `dir`; infinite when
-/// it cannot be told.
-double freeMegabytes(const std::string& dir) {
-  std::error_code ec;
-  const std::filesystem::space_info space = std::filesystem::space(dir, ec);
-  if (ec) return std::numeric_limits<double>::infinity();
-  return static_cast<double>(space.available) / 1e6;
 }
 
 }  // namespace
@@ -74,20 +66,8 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
 DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readDatasetRecorderParams(private_nh)), nh_(nh) {
   keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
-  // An unwritable directory fails now, naming it, not at the first frame.
-  std::error_code ec;
-  std::filesystem::create_directories(params_.output_dir, ec);
-  const std::string probe = params_.output_dir + "/.norm2tex_write_test";
-  if (ec || !std::ofstream(probe)) {
-    throw Error("output directory '" + params_.output_dir + "' cannot be written" +
-                (ec ? ": " + ec.message() : std::string()));
-  }
-  std::filesystem::remove(probe, ec);
-  const double free_mb = freeMegabytes(params_.output_dir);
-  if (params_.min_free_mb > 0.0 && free_mb < params_.min_free_mb) {
-    throw Error("output directory '" + params_.output_dir + "' has " + text(free_mb) +
-                " MB free, under ~min_free_mb = " + text(params_.min_free_mb) + " MB");
-  }
+  // An unwritable or full directory fails now, naming it, not at the first frame.
+  checkOutputDirectory(params_.output_dir, params_.min_free_mb);
   openNextBag();
 
   answer_pub_ = nh_.advertise<FrameRendered>(params_.answer_topic, 100, /*latch=*/true);
@@ -137,8 +117,13 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
     ready_timer_ = nh_.createWallTimer(ros::WallDuration(0.02),
                                        [this](const ros::WallTimerEvent&) { announceReady(); });
   }
-  ROS_INFO("dataset_recorder: %zu topics -> %s (%s), target %d images", topics.size(),
-           bag_paths_.back().c_str(), params_.compression.c_str(), params_.samples);
+  // ~samples 0 is no limit of the recorder's own: the frame source's plan decides (probe_sim
+  // ends with its last frame), so say that rather than "target 0".
+  const std::string until = params_.samples > 0
+                                ? "stops at " + text(params_.samples) + " images"
+                                : std::string("until the frame source's last frame");
+  ROS_INFO("dataset_recorder: %zu topics -> %s (%s), %s", topics.size(),
+           bag_paths_.back().c_str(), params_.compression.c_str(), until.c_str());
 }
 
 DatasetRecorder::~DatasetRecorder() { close(); }

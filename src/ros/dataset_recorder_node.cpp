@@ -7,6 +7,7 @@
 #include <ros/ros.h>
 
 #include "dataset_recorder.hpp"
+#include "launch_end.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace {
@@ -24,6 +25,12 @@ int main(int argc, char** argv) {
       ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
     }
     recorder.close(g_stop ? "signal" : "shutdown");
+    // Done as planned under roslaunch: end the whole launch as Ctrl-C would, and exit when
+    // roslaunch stops this node (a required node's own exit gets a red banner, even status 0).
+    if (!g_stop && recorder.error().empty() && norm2tex::endParentLaunch()) {
+      const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(10.0);
+      while (!g_stop && ros::WallTime::now() < deadline) ros::WallDuration(0.01).sleep();
+    }
     ros::shutdown();
     if (!recorder.error().empty()) {
       std::cerr << "dataset_recorder: " << recorder.error() << std::endl;

@@ -112,8 +112,9 @@ int main(int argc, char** argv) {
   norm2tex::Reset episode;
   episode.request.seed = seed;
   episode.request.height_offset = height_offset;
-  if (!reset.call(episode)) {
-    std::fprintf(stderr, "norm2tex_grasp_demo: ~reset failed\n");
+  if (!reset.call(episode) || !episode.response.success) {
+    std::fprintf(stderr, "norm2tex_grasp_demo: ~reset failed: %s\n",
+                 episode.response.message.c_str());
     return 1;
   }
 
@@ -125,7 +126,8 @@ int main(int argc, char** argv) {
     srv.request.set_command = delta != 0.0;
     srv.request.command.mode = norm2tex::GripperCommand::DELTA;
     srv.request.command.opening = delta;
-    if (!step.call(srv)) throw std::runtime_error("~step failed");
+    if (!step.call(srv)) throw std::runtime_error("~step failed (no answer)");
+    if (!srv.response.success) throw std::runtime_error(srv.response.message);
     const ros::Time stamp = srv.response.stamp;
     if (!waitFor(
             [&] {

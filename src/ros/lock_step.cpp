@@ -49,6 +49,9 @@ bool LockStep::serveAnswersUntil(std::unique_lock<std::mutex>& lock,
                                  const std::function<bool()>& done, double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!done()) {
+    // Shutting down (ros::shutdown, e.g. after another nodelet's start-up failed) or unloaded:
+    // nobody will answer any more.
+    if (cancelled_ || !ros::ok()) throw Error(owner_ + ": stopped while waiting for the renderers");
     const double left =
         std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
     if (left <= 0.0) return false;

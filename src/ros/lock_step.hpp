@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -52,6 +53,9 @@ class LockStep {
   std::uint32_t publish(const ros::Publisher& frame_pub, const SimFrame& frame);
   /// Waits until every frame in flight is answered; returns missing images as publish() does.
   std::uint32_t drain(const ros::Publisher& frame_pub);
+  /// Makes every wait, now or later, end at once with an Error ("... stopped"): a frame source
+  /// that is being unloaded (or a node shutting down) must not sit out ~ready_timeout. Any thread.
+  void cancel() { cancelled_ = true; }
 
  private:
   struct InFlight {
@@ -82,6 +86,7 @@ class LockStep {
   std::map<std::uint64_t, InFlight> in_flight_;  ///< by frame number
   std::uint32_t missing_images_ = 0;             ///< reported since the last publish/drain
   std::uint64_t answers_ = 0;                    ///< answers to frames in flight, ever
+  std::atomic<bool> cancelled_{false};
 };
 
 }  // namespace norm2tex

@@ -8,6 +8,7 @@
 
 #include "contact_sim.hpp"
 #include "dataset_recorder.hpp"
+#include "launch_end.hpp"
 #include "probe_sim.hpp"
 #include "norm2tex/common/error.hpp"
 #include "tactile_renderer_ros.hpp"
@@ -58,7 +59,8 @@ class ProbeSimNodelet : public nodelet::Nodelet {
 
 /// The recorder in the manager: no copies of the images it writes. When it is done (sample
 /// target, the source's last frame, a write error) it closes the bag and, with
-/// ~shutdown_when_done (default true), shuts the manager down as the node would exit.
+/// ~shutdown_when_done (default true), ends the launch (endParentLaunch) or shuts the manager
+/// down as the node would exit.
 class DatasetRecorderNodelet : public nodelet::Nodelet {
  public:
   ~DatasetRecorderNodelet() override {
@@ -81,11 +83,20 @@ class DatasetRecorderNodelet : public nodelet::Nodelet {
       done_timer_.stop();
       recorder_->close();
       if (!recorder_->error().empty()) NODELET_ERROR("dataset_recorder: %s", recorder_->error().c_str());
-      if (shutdown_when_done_) ros::requestShutdown();
+      if (!shutdown_when_done_) return;
+      // Done as planned under roslaunch: end the whole launch as Ctrl-C would (roslaunch then
+      // stops this manager), without the red banner a required node's exit prints. A failure
+      // keeps that banner: it is one. Should roslaunch not stop us, shut down after all.
+      if (recorder_->error().empty() && endParentLaunch()) {
+        fallback_timer_ = getNodeHandle().createWallTimer(
+            ros::WallDuration(10.0), [](const auto&) { ros::requestShutdown(); }, true);
+        return;
+      }
+      ros::requestShutdown();
     });
   }
   std::unique_ptr<DatasetRecorder> recorder_;
-  ros::WallTimer done_timer_;
+  ros::WallTimer done_timer_, fallback_timer_;
   bool shutdown_when_done_ = true;
 };
 

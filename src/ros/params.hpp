@@ -7,6 +7,9 @@
 namespace norm2tex {
 namespace ros_params {
 
+/// ~material's word for "no procedural material" (roslaunch drops empty argument values).
+constexpr const char* kNoMaterial = "none";
+
 /// <share of norm2tex>/<relative>.
 std::string packageFile(const std::string& relative);
 

@@ -167,6 +167,7 @@ ProbeSim::ProbeSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
 ProbeSim::~ProbeSim() {
   stop_ = true;
+  if (lock_step_) lock_step_->cancel();  // the runner may be waiting for the renderers
   if (runner_.joinable()) runner_.join();
   service_queue_.disable();  // wakes its spinner at once instead of at its next 0.1 s poll
   if (service_spinner_) service_spinner_->stop();
@@ -185,6 +186,8 @@ void ProbeSim::run() {
       if (!advanceFrame()) break;
     }
   } catch (const Error& e) {
+    // Unloaded or shut down meanwhile: nothing failed.
+    if (stop_ || !ros::ok()) return;
     ROS_ERROR("probe_sim: stopped at frame %ld of %lu: %s", static_cast<long>(frame_),
               static_cast<unsigned long>(schedule_->frames()), e.what());
   }
@@ -192,33 +195,40 @@ void ProbeSim::run() {
 
 bool ProbeSim::onStep(Step::Request& request, Step::Response& response) {
   std::lock_guard<std::mutex> lock(mutex_);
+  // Refusals and failures reach the caller as success = false and the reason (a service that
+  // returns false sends its caller no text), and go to the log as before.
+  auto fail = [&](const std::string& message) {
+    response.success = false;
+    response.message = message;
+    return true;
+  };
   if (request.frames < 1 || request.frames > 100000 || request.set_command) {
-    ROS_WARN("probe_sim: ~step frames = %u%s rejected; valid: [1, 100000] frames, no command",
-             request.frames, request.set_command ? " with a gripper command" : "");
-    return false;
+    const std::string message =
+        "~step frames = " + std::to_string(request.frames) +
+        (request.set_command ? " with a gripper command" : "") +
+        " refused; valid: [1, 100000] frames, no command (the probe has no gripper)";
+    ROS_WARN("probe_sim: %s", message.c_str());
+    return fail(message);
   }
   response.missing_images = 0;
   try {
     for (std::uint32_t i = 0; i < request.frames; ++i) {
       if (!advanceFrame()) {
-        ROS_WARN("probe_sim: the plan's %lu frames are done",
-                 static_cast<unsigned long>(schedule_->frames()));
-        return false;
+        const std::string message =
+            "the plan's " + std::to_string(schedule_->frames()) + " frames are done";
+        ROS_WARN("probe_sim: %s", message.c_str());
+        return fail(message);
       }
     }
-  } catch (const Error& e) {
-    ROS_ERROR("probe_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
-    return false;
-  }
-  try {
     const std::uint32_t missing = lock_step_->drain(frame_pub_);
     response.missing_images += missing;
     missing_images_ += missing;
   } catch (const Error& e) {
     ROS_ERROR("probe_sim: ~step failed at frame %ld: %s", static_cast<long>(frame_), e.what());
-    return false;
+    return fail("~step failed at frame " + std::to_string(frame_) + ": " + e.what());
   }
   response.stamp = ros_conversions::toRosTime((frame_ - 1) * period_ns_ + period_ns_);
+  response.success = true;
   return true;
 }
 

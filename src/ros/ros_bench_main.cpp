@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     // The policy loop: step one frame, wait for both of its images.
     ros::WallTime start = ros::WallTime::now();
     for (int i = 0; i < frames; ++i) {
-      if (!step.call(srv)) return fail("~step failed");
+      if (!step.call(srv) || !srv.response.success) return fail(("~step failed: " + srv.response.message).c_str());
       const ros::Time stamp = srv.response.stamp;
       if (!waitFor([&] { return arrivals.count[stamp] == 2; }, 10))
         return fail("a step's two images did not arrive within 10 s");
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
     // each, on the cores the renderers need.)
     std::atomic<bool> called{false}, step_ok{false};
     std::thread caller([&] {
-      step_ok = step.call(srv);
+      step_ok = step.call(srv) && srv.response.success;
       called = true;
     });
     // Until the call returned and every image is here, or none has come for 2 s (a subscriber

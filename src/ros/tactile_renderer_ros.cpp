@@ -44,12 +44,14 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("normal_map", p.normal_map, "");
   pnh.param<std::string>("convention", p.convention, p.convention);
   pnh.param<std::string>("atlas", p.atlas, "");
-  // A material unless a texture file is given.
+  // A material unless a texture file is given. "none" is '' in a word: roslaunch drops empty
+  // argument values, so a launch file cannot pass ''.
   pnh.param<std::string>("material", p.material,
                          p.normal_map.empty() && p.atlas.empty() ? "wood" : "");
+  if (p.material == ros_params::kNoMaterial) p.material.clear();
   if (!p.material.empty()) {
-    p.material_config =
-        ros_params::materialConfigPath(p.material, ", or '' with ~normal_map or ~atlas");
+    p.material_config = ros_params::materialConfigPath(
+        p.material, ", or none (the mesh's own texture, or ~normal_map or ~atlas)");
   }
   pnh.param("variant", p.variant, 0);
   if (p.variant < 0) badParameter("variant", std::to_string(p.variant), ">= 0");
@@ -175,7 +177,7 @@ void TactileRendererRos::useTexture(const TextureSource& source, const std::stri
   }
   const double beta = params_.beta >= 0.0     ? params_.beta
                       : texture.beta_mm > 0.0 ? texture.beta_mm
-                                              : 0.1;
+                                              : kFileTextureBetaMm;
   const std::string warning =
       renderer_->setObject(mesh_, texture.atlas, texture.atlas ? beta : 0.0);
   if (!warning.empty()) ROS_WARN("%s: %s", params_.sensor_name.c_str(), warning.c_str());

@@ -30,7 +30,7 @@ struct TactileRendererParams {
   std::string scene;            ///< ~scene: the object mesh and scale come from this scene yaml ...
   std::string mesh;             ///< ~mesh: ... unless given here (file or box:/sphere: primitive)
   double scale = 1.0;           ///< ~scale with ~mesh
-  std::string material;         ///< ~material: procedural material name, or "" (see ~normal_map)
+  std::string material;         ///< ~material: procedural material name, or "" (~material none)
   std::string material_config;  ///< resolved config/materials/<material>.yaml
   int variant = 0;              ///< ~variant
   int material_seed = 0;        ///< ~material_seed

@@ -236,6 +236,10 @@ TEST(GripperSimTest, BadCommandsAreRejectedAndChangeNothing) {
   test::expectError([&] { sim.addOpening(NAN); }, {"delta", "[-1, 1]"});
   test::expectError([&] { sim.addOpening(2.0); }, {"delta"});
   test::expectError([&] { sim.reset(1, NAN); }, {"height offset"});
+  // Outside the scene's range: refused with the range (0.5 m used to be taken and labelled).
+  for (double offset : {0.5, 0.03, -0.5, -1e-4}) {
+    test::expectError([&] { sim.reset(1, offset); }, {"height offset", "[0, 0.025]"});
+  }
   EXPECT_EQ(sim.commandedOpening(), 0.6);
   sim.addOpening(0.5);
   EXPECT_EQ(sim.commandedOpening(), 1.0);  // clamped

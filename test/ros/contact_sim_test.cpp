@@ -195,16 +195,24 @@ TEST(Synchronous, StepsAdvanceClockAndTfByExactlyTheirFramesAndNothingElse) {
   srv.request.command.mode = norm2tex::GripperCommand::DELTA;
   srv.request.command.opening = 0.005;
   ASSERT_TRUE(step.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
   EXPECT_NEAR(srv.response.opening, before + 0.005, 1e-6);
+  // Refusals come back to the caller with the reason, and change nothing.
   srv.request.command.opening = std::nan("");
-  EXPECT_FALSE(step.call(srv));
+  ASSERT_TRUE(step.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("[-1, 1]"), std::string::npos) << srv.response.message;
   srv.request.set_command = false;
   srv.request.frames = 1;
   ASSERT_TRUE(step.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
   EXPECT_NEAR(srv.response.opening, before + 0.005, 1e-6);
   EXPECT_EQ(srv.response.stamp.toNSec() - last.toNSec(), 31 * period_ns);
   srv.request.frames = 0;
-  EXPECT_FALSE(step.call(srv));
+  ASSERT_TRUE(step.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("frames = 0"), std::string::npos) << srv.response.message;
+  EXPECT_NE(srv.response.message.find("[1, 100000]"), std::string::npos) << srv.response.message;
 }
 
 TEST(Synchronous, ResetPlacesTheObjectAndPublishesTheEpisode) {
@@ -215,6 +223,7 @@ TEST(Synchronous, ResetPlacesTheObjectAndPublishesTheEpisode) {
   srv.request.seed = 11;
   srv.request.height_offset = 0.012;
   ASSERT_TRUE(reset.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
   EXPECT_DOUBLE_EQ(srv.response.info.height_offset, 0.012);
   EXPECT_EQ(srv.response.info.material, "fabric");
   EXPECT_EQ(srv.response.info.object, "cube");
@@ -244,8 +253,28 @@ TEST(Synchronous, ResetPlacesTheObjectAndPublishesTheEpisode) {
   ASSERT_TRUE(reset.call(srv));
   EXPECT_GE(srv.response.info.height_offset, 0.0);
   EXPECT_LE(srv.response.info.height_offset, 0.025);
+  const std::uint32_t episode = srv.response.info.episode;
+  // Offsets outside the scene's [0, 25] mm are refused with the range, not run or relabelled;
+  // so is a negative seed. No episode starts.
+  for (double offset : {0.5, 0.03, -0.5, -0.001}) {
+    srv.request.seed = 1;
+    srv.request.height_offset = offset;
+    ASSERT_TRUE(reset.call(srv)) << offset;
+    EXPECT_FALSE(srv.response.success) << offset;
+    EXPECT_NE(srv.response.message.find("height offset"), std::string::npos)
+        << srv.response.message;
+    EXPECT_NE(srv.response.message.find("[0, 0.025]"), std::string::npos) << srv.response.message;
+  }
   srv.request.seed = -1;
-  EXPECT_FALSE(reset.call(srv));
+  srv.request.height_offset = 0.01;
+  ASSERT_TRUE(reset.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("seed -1"), std::string::npos) << srv.response.message;
+  EXPECT_NE(srv.response.message.find(">= 0"), std::string::npos) << srv.response.message;
+  srv.request.seed = 2;
+  ASSERT_TRUE(reset.call(srv));
+  EXPECT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.info.episode, episode + 1);
 }
 
 }  // namespace

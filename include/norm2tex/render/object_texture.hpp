@@ -10,6 +10,10 @@
 
 namespace norm2tex {
 
+/// Texture depth (mm) of a normal map or atlas given without a beta: a texture file carries no
+/// depth of its own, as a material's beta_mm does.
+constexpr double kFileTextureBetaMm = 0.1;
+
 /// Where an object's texture comes from: at most one of a procedural material, a normal map or
 /// a baked atlas; none of them = the mesh's own normal texture, if it has one.
 struct TextureSource {

@@ -73,7 +73,8 @@ class GripperSim {
   /// Re-seats the object between the open gels at `height_offset_m` (or, when absent, one drawn
   /// uniformly from the configured range with `seed`), closes to the grasp opening without
   /// gravity on the object, then lets it settle under gravity for episode.settle_s. Simulated
-  /// time keeps running through it. Throws Error for a non-finite offset.
+  /// time keeps running through it. Throws Error (and changes nothing) for an offset outside
+  /// the scene's [episode.height_offset_low_m, height_offset_high_m] or NaN.
   EpisodeStart reset(std::uint64_t seed, std::optional<double> height_offset_m = std::nullopt);
 
   /// Normalised opening command, 0 = closed (gap min_gap) ... 1 = open (gap max_gap). Throws

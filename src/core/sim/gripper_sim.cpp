@@ -377,9 +377,13 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
                             ? *height_offset_m
                             : e.height_offset_low_m +
                                   uniform01(rng) * (e.height_offset_high_m - e.height_offset_low_m);
-  if (!std::isfinite(offset) || std::abs(offset) > 0.5) {
+  // Outside the scene's range the grasp is not the scene's (too high: the object barely touches
+  // the gels; below: it tumbles), so a given offset is refused rather than clamped.
+  if (!(offset >= e.height_offset_low_m && offset <= e.height_offset_high_m)) {
     std::ostringstream message;
-    message << "height offset " << offset << " m is out of range; valid: finite, within 0.5 m";
+    message << "height offset " << offset << " m is out of the scene's range; valid: ["
+            << e.height_offset_low_m << ", " << e.height_offset_high_m
+            << "] m (episode.height_offset_mm)";
     throw Error(message.str());
   }
   EpisodeStart start;

@@ -1,0 +1,144 @@
+// The launch files through roslaunch itself, on masters of their own: a mistake the launch can
+// see before any node starts (an output directory that cannot be written, a missing file) ends
+// roslaunch at once with a non-zero status and the reason; a finished recording ends quietly.
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "run_node.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+
+const fs::path& scratch() {
+  static const fs::path dir = [] {
+    const fs::path d =
+        fs::temp_directory_path() / ("norm2tex_launch_test_" + std::to_string(getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d / "ros_home");
+    return d;
+  }();
+  return dir;
+}
+
+int freePort() {
+  std::string output;
+  EXPECT_EQ(norm2tex::test::runCommand(std::string(NORM2TEX_SOURCE_DIR) + "/scripts/free_port",
+                                       output),
+            0)
+      << output;
+  return std::stoi(output);
+}
+
+struct LaunchRun {
+  int status = -1;
+  double seconds = 0.0;
+  std::string output;
+};
+
+/// Runs `roslaunch norm2tex <args>` on a master of its own until it exits (a hard cap of 120 s
+/// stops a launch that would hang, which the assertions on `seconds` then report).
+LaunchRun launch(const std::string& args) {
+  const int port = freePort();
+  std::ostringstream command;
+  command << "ROS_HOME=" << (scratch() / "ros_home") << " ROS_MASTER_URI=http://localhost:" << port
+          << " timeout -s INT -k 10 120 roslaunch -p " << port << " norm2tex " << args;
+  LaunchRun run;
+  const auto start = std::chrono::steady_clock::now();
+  run.status = norm2tex::test::runCommand(command.str(), run.output);
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+/// The output has `line` as a line of its own (the reason is not buried in another message).
+bool hasLine(const std::string& output, const std::string& line) {
+  std::istringstream in(output);
+  for (std::string l; std::getline(in, l);) {
+    if (l == line) return true;
+  }
+  return false;
+}
+
+TEST(LaunchFailure, AnOutputDirectoryThatCannotBeWrittenEndsTheLaunchAtOnceWithTheReason) {
+  const fs::path file = scratch() / "a_file";
+  std::ofstream(file) << "not a directory\n";
+  struct Case {
+    std::string out, reason;
+  } cases[] = {
+      {(file / "out").string(), "record_dataset.launch: output directory '" +
+                                    (file / "out").string() +
+                                    "' cannot be written: Not a directory"},
+      {"/proc/norm2tex_cannot_write", "record_dataset.launch: output directory "
+                                      "'/proc/norm2tex_cannot_write' cannot be written"},
+  };
+  for (const Case& c : cases) {
+    const LaunchRun run = launch("record_dataset.launch samples:=10 out:=" + c.out);
+    EXPECT_NE(run.status, 0) << run.output;
+    EXPECT_LT(run.seconds, 5.0) << run.output;
+    EXPECT_NE(run.output.find(c.reason), std::string::npos) << run.output;
+    // No node was started: nothing to tear down, no banner.
+    EXPECT_EQ(run.output.find("REQUIRED process"), std::string::npos) << run.output;
+  }
+}
+
+TEST(LaunchFailure, AMissingFileEndsTheLaunchAtOnceWithTheReason) {
+  const std::string missing = (scratch() / "no_such_mesh.obj").string();
+  const LaunchRun run = launch("gripper_sim.launch mesh:=" + missing + " scale:=0.001");
+  EXPECT_NE(run.status, 0) << run.output;
+  EXPECT_LT(run.seconds, 5.0) << run.output;
+  EXPECT_TRUE(hasLine(run.output, "gripper_sim.launch: mesh file '" + missing +
+                                      "' does not exist"))
+      << run.output;
+  const std::string no_map = (scratch() / "no_such_normals.png").string();
+  const LaunchRun map_run = launch("gripper_sim.launch material:=none normal_map:=" + no_map);
+  EXPECT_NE(map_run.status, 0) << map_run.output;
+  EXPECT_TRUE(hasLine(map_run.output, "gripper_sim.launch: normal_map file '" + no_map +
+                                          "' does not exist"))
+      << map_run.output;
+}
+
+TEST(LaunchFailure, ANodeletThatFailsAtStartUpEndsTheLaunchWithoutWaitingForTheOthers) {
+  // A mistake only the recorder sees (its compression), loaded after probe_sim, which waits
+  // for its renderers: the manager used to sit out probe_sim's ~ready_timeout (60 s) first.
+  // roslaunch's own status stays 0 here (a required node died; roslaunch 1.15 does not pass
+  // statuses on), so the reason is what the output must carry.
+  const LaunchRun run = launch("record_dataset.launch samples:=10 compression:=zip out:=" +
+                               (scratch() / "zip").string());
+  EXPECT_LT(run.seconds, 15.0) << run.output;
+  EXPECT_NE(run.output.find("~compression = 'zip' is not valid; valid: lz4, bz2, none"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("REQUIRED process [norm2tex_manager"), std::string::npos)
+      << run.output;
+}
+
+TEST(LaunchEnd, AFinishedRecordingEndsTheLaunchQuietly) {
+  const fs::path out = scratch() / "recording";
+  const LaunchRun run =
+      launch("record_dataset.launch material:=wood variants:=1 samples:=10 out:=" + out.string());
+  EXPECT_EQ(run.status, 0) << run.output;
+  std::ifstream manifest(out / "norm2tex_shard0.yaml");
+  std::stringstream text;
+  text << manifest.rdbuf();
+  EXPECT_NE(text.str().find("complete: true"), std::string::npos) << text.str();
+  // A clean end is no failure: no red "REQUIRED process [...] has died!" banner.
+  EXPECT_EQ(run.output.find("REQUIRED process"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("has died"), std::string::npos) << run.output;
+  // The recorder says when it stops, not "target 0 images".
+  EXPECT_EQ(run.output.find("target 0 images"), std::string::npos) << run.output;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  const int result = RUN_ALL_TESTS();
+  fs::remove_all(scratch());
+  return result;
+}

@@ -1,0 +1,109 @@
+// rostests of what users bring through gripper_sim.launch: their own normal map instead of a
+// procedural material (own_texture.test), and the physics' friction without a material
+// (own_friction.test). Conditions are awaited with deadlines.
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+#include <opencv2/core.hpp>
+
+#include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/Reset.h"
+#include "norm2tex/Step.h"
+#include "wait_for.hpp"
+
+namespace {
+
+using norm2tex::waitFor;
+
+cv::Mat view(const sensor_msgs::Image& msg) {
+  const int type = msg.encoding == "bgr8" ? CV_8UC3 : CV_8UC1;
+  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), type,
+                 const_cast<std::uint8_t*>(msg.data.data()), msg.step);
+}
+
+TEST(OwnTexture, ANormalMapWithoutMaterialTexturesTheContactAndLabelsTheEpisode) {
+  ros::NodeHandle nh;
+  std::map<std::string, std::map<ros::Time, sensor_msgs::Image::ConstPtr>> image, mask;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string s : {"digit_left", "digit_left_bare"}) {
+    subs.push_back(nh.subscribe<sensor_msgs::Image>(
+        s + "/image_raw", 100, [&, s](const auto& m) { image[s][m->header.stamp] = m; }));
+    subs.push_back(nh.subscribe<sensor_msgs::Image>(
+        s + "/contact_mask", 100, [&, s](const auto& m) { mask[s][m->header.stamp] = m; }));
+  }
+  ros::ServiceClient reset = nh.serviceClient<norm2tex::Reset>("/contact_sim/reset");
+  ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const ros::Subscriber& sub : subs) {
+          if (sub.getNumPublishers() == 0) return false;
+        }
+        return true;
+      },
+      60.0));
+  norm2tex::Reset episode;
+  episode.request.seed = 2;
+  episode.request.height_offset = 0.010;
+  ASSERT_TRUE(reset.call(episode));
+  ASSERT_TRUE(episode.response.success) << episode.response.message;
+  EXPECT_EQ(episode.response.info.material, "none");
+  EXPECT_DOUBLE_EQ(episode.response.info.beta, 0.3);  // the given beta, not a material's
+  norm2tex::Step one;
+  one.request.frames = 1;
+  ASSERT_TRUE(step.call(one));
+  ASSERT_TRUE(one.response.success) << one.response.message;
+  EXPECT_EQ(one.response.missing_images, 0u);
+  const ros::Time t = one.response.stamp;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return image["digit_left"].count(t) && image["digit_left_bare"].count(t) &&
+               mask["digit_left"].count(t) && mask["digit_left_bare"].count(t);
+      },
+      10.0));
+  const cv::Mat contact = view(*mask["digit_left"][t]);
+  // Same geometry, so the same contact; inside it the normal map's relief shows.
+  EXPECT_EQ(cv::norm(contact, view(*mask["digit_left_bare"][t]), cv::NORM_INF), 0.0);
+  ASSERT_GT(cv::countNonZero(contact), 5000);
+  cv::Mat diff;
+  cv::absdiff(view(*image["digit_left"][t]), view(*image["digit_left_bare"][t]), diff);
+  const cv::Scalar inside = cv::mean(diff, contact);
+  EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 1.0);
+
+  std::string normal_map;
+  if (nh.getParam("/own_texture_test/normal_map", normal_map)) std::remove(normal_map.c_str());
+}
+
+TEST(OwnFriction, WithoutAMaterialTheGivenFrictionIsThePhysics) {
+  ros::NodeHandle nh;
+  ros::ServiceClient reset = nh.serviceClient<norm2tex::Reset>("/contact_sim/reset");
+  ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  norm2tex::Reset episode;
+  episode.request.seed = 1;
+  episode.request.height_offset = 0.010;
+  ASSERT_TRUE(reset.call(episode));
+  ASSERT_TRUE(episode.response.success) << episode.response.message;
+  EXPECT_EQ(episode.response.info.material, "none");
+  // The cube slides out under its own weight: dropped within 2 s of simulated time.
+  norm2tex::Step srv;
+  srv.request.frames = 12;
+  for (int i = 0; i < 10 && !srv.response.dropped; ++i) {
+    ASSERT_TRUE(step.call(srv));
+    ASSERT_TRUE(srv.response.success) << srv.response.message;
+  }
+  EXPECT_TRUE(srv.response.dropped);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "own_objects_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
