@@ -1,4 +1,4 @@
-#!/usr/bin/python3
+#!/usr/bin/env python3
 """Summarise the JUnit XML files that `catkin_make run_tests` leaves behind.
 
 Usage: junit_summary.py RESULTS_DIR [--runner-rc N]

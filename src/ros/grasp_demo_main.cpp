@@ -5,6 +5,7 @@
 //   norm2tex_grasp_demo OUT_DIR [--seed S] [--height-offset M]
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -43,9 +44,19 @@ cv::Mat3b toMat(const sensor_msgs::Image& msg) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* const usage =
+      "usage: norm2tex_grasp_demo OUT_DIR [--seed S] [--height-offset M]\n"
+      "  Runs the grasp on a synchronous gripper_sim.launch (started separately) and saves both\n"
+      "  DIGITs' images at several moments, and a labelled strip of them, in OUT_DIR.\n";
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      std::fputs(usage, stdout);
+      return 0;
+    }
+  }
   ros::init(argc, argv, "norm2tex_grasp_demo", ros::init_options::AnonymousName);
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: norm2tex_grasp_demo OUT_DIR [--seed S] [--height-offset M]\n");
+  if (argc < 2 || argc % 2 != 0) {
+    std::fputs(usage, stderr);
     return 2;
   }
   const std::filesystem::path out = argv[1];
@@ -53,12 +64,20 @@ int main(int argc, char** argv) {
   double height_offset = 0.008;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
-    if (flag == "--seed") {
-      seed = std::stoll(argv[i + 1]);
-    } else if (flag == "--height-offset") {
-      height_offset = std::stod(argv[i + 1]);
-    } else {
-      std::fprintf(stderr, "norm2tex_grasp_demo: unknown option %s\n", flag.c_str());
+    try {
+      size_t used = 0;
+      if (flag == "--seed") {
+        seed = std::stoll(argv[i + 1], &used);
+      } else if (flag == "--height-offset") {
+        height_offset = std::stod(argv[i + 1], &used);
+      } else {
+        std::fprintf(stderr, "norm2tex_grasp_demo: unknown option %s\n%s", flag.c_str(), usage);
+        return 2;
+      }
+      if (argv[i + 1][used] != '\0') throw std::invalid_argument("trailing characters");
+    } catch (const std::exception&) {
+      std::fprintf(stderr, "norm2tex_grasp_demo: %s %s is not a number\n%s", flag.c_str(),
+                   argv[i + 1], usage);
       return 2;
     }
   }

@@ -13,6 +13,8 @@
 // Each nodelet reads its parameters from its own private namespace (/probe_sim/...), as when
 // loaded by a client; names are resolved in the group's namespace. ~num_worker_threads as for
 // `nodelet manager`.
+#include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -52,6 +54,17 @@ std::vector<NodeletSpec> readNodelets(const ros::NodeHandle& pnh, std::string* w
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      std::fputs(
+          "usage: rosrun norm2tex nodelet_group [__name:=NAME]  (usually from a launch file)\n"
+          "  A nodelet manager that loads the nodelets of its ~nodelets parameter itself:\n"
+          "  ~nodelets: [{name: NAME, type: PACKAGE/Type}, ...]; ~num_worker_threads as for\n"
+          "  `nodelet manager`.\n",
+          stdout);
+      return 0;
+    }
+  }
   ros::init(argc, argv, "nodelet_group");
   ros::NodeHandle pnh("~");
   std::string why;

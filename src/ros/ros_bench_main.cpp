@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <map>
 #include <string>
 #include <thread>
@@ -47,15 +49,23 @@ double percentile(std::vector<double> v, double p) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* const usage =
+      "usage: norm2tex_ros_bench synchronous [FRAMES >= 10]\n"
+      "       norm2tex_ros_bench real_time [FRAMES >= 10] [split]\n";
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      std::fputs(usage, stdout);
+      return 0;
+    }
+  }
   ros::init(argc, argv, "norm2tex_ros_bench", ros::init_options::AnonymousName);
   const std::string mode = argc > 1 ? argv[1] : "";
-  const int frames = argc > 2 ? std::stoi(argv[2]) : 600;
+  // A malformed FRAMES counts as too few: the usage, not an uncaught exception.
+  const int frames = argc > 2 ? std::atoi(argv[2]) : 600;
   const bool split = argc > 3 && std::string(argv[3]) == "split";
   if ((mode != "synchronous" && mode != "real_time") || frames < 10 || (argc > 3 && !split) ||
       argc > 4) {
-    std::fprintf(stderr,
-                 "usage: norm2tex_ros_bench synchronous [FRAMES >= 10]\n"
-                 "       norm2tex_ros_bench real_time [FRAMES >= 10] [split]\n");
+    std::fputs(usage, stderr);
     return 2;
   }
   ros::NodeHandle nh;

@@ -4,9 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +15,7 @@
 
 #include "cli_arguments.hpp"
 #include "norm2tex/calibrate/calibration_report.hpp"
+#include "norm2tex/calibrate/press_labels.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/image_io.hpp"
@@ -43,7 +42,8 @@ constexpr const char* kUsage =
     "  --mm-per-pixel: the scale, if you know it (recommended); otherwise it is fitted, but\n"
     "          ball presses pin it only weakly (the range that fits as well is printed).\n"
     "  --labels: CSV lines 'file,centre_x_px,centre_y_px,radius_px' (file: as given or its base\n"
-    "          name) for presses whose contact circle you know; the others are detected.\n"
+    "          name, so paths from another machine work; an optional header line; CRLF is\n"
+    "          fine) for presses whose contact circle you know; the others are detected.\n"
     "  --size WxH: resample every frame to this size first (e.g. 240x320 for VGA captures of a\n"
     "          QVGA sensor). Default: the frames' own size.\n"
     "  --sensor: the sensor yaml to start from (gel, camera); default: the built-in DIGIT.\n"
@@ -124,48 +124,13 @@ norm2tex::SensorModel baseModel(const norm2tex::cli::Arguments& args, cv::Size f
   return model;
 }
 
-// Labels CSV: file,centre_x_px,centre_y_px,radius_px (a header line is skipped).
+// Labels CSV (norm2tex/calibrate/press_labels.hpp): matched to the presses by path or base name.
 std::vector<std::optional<norm2tex::PressCircle>> loadLabels(
     const std::string& path, const std::vector<norm2tex::NamedFrame>& presses) {
-  std::ifstream file(path);
-  if (!file) throw Error("labels '" + path + "': cannot be read");
-  std::map<std::string, norm2tex::PressCircle> by_name;
-  std::string line;
-  for (int number = 1; std::getline(file, line); ++number) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream in(line);
-    std::string name, field;
-    std::vector<double> values;
-    std::getline(in, name, ',');
-    while (std::getline(in, field, ',')) {
-      try {
-        values.push_back(std::stod(field));
-      } catch (const std::exception&) {
-        values.clear();
-        break;
-      }
-    }
-    if (values.size() != 3 || !(values[2] > 0.0)) {
-      if (number == 1) continue;  // a header
-      throw Error("labels '" + path + "' line " + std::to_string(number) +
-                  ": expected 'file,centre_x_px,centre_y_px,radius_px' with radius > 0");
-    }
-    by_name[name] = norm2tex::PressCircle{{values[0], values[1]}, values[2]};
-  }
-  std::vector<std::optional<norm2tex::PressCircle>> labels(presses.size());
-  size_t used = 0;
-  for (size_t i = 0; i < presses.size(); ++i) {
-    const std::string base = std::filesystem::path(presses[i].name).filename().string();
-    for (const std::string& key : {presses[i].name, base}) {
-      if (by_name.count(key)) {
-        labels[i] = by_name[key];
-        ++used;
-        break;
-      }
-    }
-  }
-  if (used == 0) throw Error("labels '" + path + "' name none of the --presses files");
-  return labels;
+  std::vector<std::string> names;
+  for (const norm2tex::NamedFrame& press : presses) names.push_back(press.name);
+  return norm2tex::matchPressLabels(norm2tex::readPressLabels(path), names,
+                                    "labels '" + path + "'");
 }
 
 // Ball presses pin the scale only weakly (ScaleSearch): say so when the fit ran to an end of the

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace norm2tex {
 namespace cli {
@@ -74,7 +75,20 @@ int Arguments::integer(const std::string& name, int fallback) const {
   return static_cast<int>(parsed);
 }
 
+bool asksForHelp(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) return true;
+  }
+  return false;
+}
+
 int runMain(const char* name, const char* usage, int (*run)(int, char**), int argc, char** argv) {
+  // Help is asked for, not a mistake: the usage on stdout and success, before any option is
+  // checked (so `tool --help` works whatever else is on the line).
+  if (asksForHelp(argc, argv)) {
+    std::fputs(usage, stdout);
+    return 0;
+  }
   try {
     return run(argc, argv);
   } catch (const UsageError& e) {

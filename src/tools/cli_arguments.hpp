@@ -41,9 +41,13 @@ class Arguments {
   std::set<std::string> flags_;
 };
 
+/// True when an argument is exactly `-h` or `--help`.
+bool asksForHelp(int argc, char** argv);
+
 /// Runs a tool's `run` and turns what it throws into the tools' shared exit convention:
-/// UsageError -> "<name>: <reason>" plus the usage on stderr, exit 2; any other exception ->
-/// one line "<name>: error: <reason>", exit 1.
+/// `-h`/`--help` anywhere -> the usage on stdout, exit 0 (run is not called); UsageError ->
+/// "<name>: <reason>" plus the usage on stderr, exit 2; any other exception -> one line
+/// "<name>: error: <reason>", exit 1.
 int runMain(const char* name, const char* usage, int (*run)(int, char**), int argc, char** argv);
 
 }  // namespace cli

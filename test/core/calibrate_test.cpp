@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "norm2tex/calibrate/ball_press.hpp"
 #include "norm2tex/calibrate/calibration_report.hpp"
 #include "norm2tex/calibrate/press_detection.hpp"
+#include "norm2tex/calibrate/press_labels.hpp"
 #include "norm2tex/calibrate/press_refinement.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include "norm2tex/common/error.hpp"
@@ -260,6 +262,91 @@ TEST(Calibration, BadInputIsAClearError) {
   CalibrationInput no_background = good;
   no_background.backgrounds.clear();
   test::expectError([&] { calibrateSensor(m, no_background); }, {"background"});
+}
+
+// A labels file made on another machine (test/fixtures/digit_s09/labels_other_machine.csv):
+// header line, CRLF, that machine's absolute paths. It labels the presses given here by their
+// own paths, matched on base names.
+TEST(PressLabels, LabelsFromAnotherMachineMatchByBaseName) {
+  const std::string fixtures = NORM2TEX_SOURCE_DIR "/test/fixtures/digit_s09/";
+  const std::vector<PressLabel> labels = readPressLabels(fixtures + "labels_other_machine.csv");
+  ASSERT_EQ(labels.size(), 6u);
+  EXPECT_EQ(labels[0].name, "/home/someone/data/images/frame_0.jpg");  // no '\r' kept
+  EXPECT_EQ(labels[0].line, 2);
+  EXPECT_DOUBLE_EQ(labels[5].circle.centre_px.x, 185.7);
+  EXPECT_DOUBLE_EQ(labels[5].circle.centre_px.y, 103.1);
+  EXPECT_DOUBLE_EQ(labels[5].circle.radius_px, 46.2);  // "46.2\r" read as a number
+  // Presses 0..12 here: the labelled ones (0..10) get their circles, frame_12 none.
+  std::vector<std::string> presses;
+  for (int i = 0; i <= 12; i += 2)
+    presses.push_back(fixtures + "frame_" + std::to_string(i) + ".jpg");
+  const std::vector<std::optional<PressCircle>> circles =
+      matchPressLabels(labels, presses, "labels");
+  ASSERT_EQ(circles.size(), presses.size());
+  for (size_t i = 0; i < 6; ++i) {
+    ASSERT_TRUE(circles[i].has_value()) << presses[i];
+    EXPECT_EQ(circles[i]->centre_px, labels[i].circle.centre_px) << presses[i];
+    EXPECT_EQ(circles[i]->radius_px, labels[i].circle.radius_px) << presses[i];
+  }
+  EXPECT_FALSE(circles[6].has_value());
+  // The circles are where the presses are: the detector agrees within a few pixels.
+  const NamedFrame background = fixtureFrame(30);
+  const NamedFrame press = fixtureFrame(4);
+  cv::Mat3f diff;
+  cv::subtract(press.image, background.image, diff, cv::noArray(), CV_32F);
+  const PressCircle detected = detectPress(diff, press.name);
+  EXPECT_LT(cv::norm(detected.centre_px - circles[2]->centre_px), 3.0);
+}
+
+TEST(PressLabels, ExactPathsWinAndAmbiguityIsAnError) {
+  std::istringstream text(
+      "\xEF\xBB\xBF# made by hand\r\n"
+      "\r\n"
+      "a/frame_1.png,1,2,3\r\n"
+      "\"C:\\data\\frame, two.png\",4,5,6\n");
+  const std::vector<PressLabel> labels = parsePressLabels(text, "labels");
+  ASSERT_EQ(labels.size(), 2u);
+  EXPECT_EQ(labels[1].name, "C:\\data\\frame, two.png");
+  // Two presses named frame_1.png: the label's exact path picks one.
+  const auto circles =
+      matchPressLabels(labels, {"b/frame_1.png", "a/frame_1.png", "x/frame, two.png"}, "labels");
+  EXPECT_FALSE(circles[0].has_value());
+  ASSERT_TRUE(circles[1].has_value());
+  EXPECT_EQ(circles[1]->radius_px, 3.0);
+  ASSERT_TRUE(circles[2].has_value());  // a Windows path's base name
+  EXPECT_EQ(circles[2]->radius_px, 6.0);
+  // A foreign path whose base name two presses share cannot be placed.
+  std::istringstream foreign("/home/someone/frame_1.png,1,2,3\n");
+  test::expectError(
+      [&] {
+        matchPressLabels(parsePressLabels(foreign, "labels 'l.csv'"),
+                         {"b/frame_1.png", "a/frame_1.png"}, "labels 'l.csv'");
+      },
+      {"labels 'l.csv' line 1", "b/frame_1.png", "a/frame_1.png"});
+  // Two labels for one press.
+  std::istringstream twice("/x/f.png,1,2,3\n/y/f.png,1,2,4\n");
+  test::expectError(
+      [&] { matchPressLabels(parsePressLabels(twice, "labels"), {"f.png"}, "labels"); },
+      {"lines 1 and 2", "f.png"});
+  // None of the presses.
+  std::istringstream other("/x/g.png,1,2,3\n");
+  test::expectError(
+      [&] { matchPressLabels(parsePressLabels(other, "labels"), {"d/f.png"}, "labels"); },
+      {"name none", "f.png"});
+}
+
+TEST(PressLabels, MalformedLinesNameTheLine) {
+  const auto expectLineError = [](const std::string& text, const std::string& fragment) {
+    std::istringstream in(text);
+    test::expectError([&] { parsePressLabels(in, "labels 'l.csv'"); },
+                      {"labels 'l.csv'", fragment});
+  };
+  expectLineError("file,x,y,r\nf.png,1,2\n", "line 2");       // a field short
+  expectLineError("f.png,1,2\n", "line 1");                   // too few numbers is no header
+  expectLineError("f.png,1,2,3\ng.png,1,two,3\n", "line 2");  // a second header is a mistake
+  expectLineError("f.png,1,2,0\n", "radius_px must be > 0");
+  expectLineError(",1,2,3\n", "file name is empty");
+  test::expectError([] { readPressLabels("/no/such/labels.csv"); }, {"/no/such/labels.csv"});
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // Every shipped yaml under config/ loads with its loader and validates (as cartographer's
 // configuration_files_test does): a yaml nobody loads, or one a loader rejects, fails here.
+// Shipped Python scripts start with a shebang that honours the user's environment.
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -32,6 +34,27 @@ TEST(ConfigFilesTest, EveryShippedYamlLoads) {
     ++loaded;
   }
   EXPECT_GE(loaded, 8);  // digit, 5 materials, 2 scenes
+}
+
+// Shipped Python scripts run on the user's python3, found on PATH: `#!/usr/bin/python3` would
+// bypass the venv or conda environment where ROS 1 users on Ubuntu 20.04 pip-install torch.
+TEST(ConfigFilesTest, PythonScriptsRunOnThePythonOnPath) {
+  int scripts = 0;
+  for (const char* folder : {"scripts", "python", "test/python"}) {
+    const std::filesystem::path root = std::filesystem::path(NORM2TEX_SOURCE_DIR) / folder;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(root)) {
+      if (!entry.is_regular_file()) continue;
+      std::ifstream file(entry.path());
+      std::string first_line;
+      std::getline(file, first_line);
+      if (first_line.rfind("#!", 0) != 0 || first_line.find("python") == std::string::npos) {
+        continue;
+      }
+      EXPECT_EQ(first_line, "#!/usr/bin/env python3") << entry.path();
+      ++scripts;
+    }
+  }
+  EXPECT_GE(scripts, 4);  // merge_dataset, train_material_classifier, junit_summary.py, free_port
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#!/usr/bin/python3
+#!/usr/bin/env python3
 """Runs a unittest file and writes a JUnit XML result, for catkin_run_tests_target.
 
 Usage: junit_unittest.py TEST_FILE RESULT_XML [ARGS passed to the test as sys.argv[1:]]

@@ -122,5 +122,18 @@ class DatasetTest(unittest.TestCase):
             ExportedDataset(self.export, image="rgb")
 
 
+class ExportCliTest(unittest.TestCase):
+    def test_help_prints_the_usage_and_succeeds(self):
+        for flag in ("--help", "-h"):
+            run = subprocess.run([EXPORT, flag], capture_output=True, text=True)
+            self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+            self.assertIn("usage: norm2tex_export BAG", run.stdout)
+            self.assertNotIn("unknown option", run.stdout + run.stderr)
+        # A mistake is still one: the usage on stderr, exit 2.
+        run = subprocess.run([EXPORT, "--no-such-option"], capture_output=True, text=True)
+        self.assertEqual(run.returncode, 2, run.stdout + run.stderr)
+        self.assertIn("usage: norm2tex_export", run.stderr)
+
+
 if __name__ == "__main__":
     unittest.main()

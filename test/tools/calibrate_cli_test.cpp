@@ -118,6 +118,44 @@ TEST_F(CalibrateCli, LabelsReplaceDetection) {
   EXPECT_NE(bad.output.find("bad_labels.csv"), std::string::npos) << bad.output;
 }
 
+// Labels written on another machine: its absolute paths, CRLF line ends, a header line. They
+// label the presses by base name; two presses of one base name make such a label ambiguous.
+TEST_F(CalibrateCli, LabelsFromAnotherMachineMatchByBaseName) {
+  {
+    std::ifstream ours(path("labels.csv"));
+    std::ofstream theirs(path("their_labels.csv"), std::ios::binary);
+    std::string line;
+    std::getline(ours, line);
+    theirs << "image,center_x,center_y,radius\r\n";
+    while (std::getline(ours, line)) theirs << "/home/someone/data/images/" << line << "\r\n";
+  }
+  const CliRun run = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                               " --ball-diameter-mm 6 --mm-per-pixel 0.054 --labels " +
+                               path("their_labels.csv") + " -o " + path("theirs.yaml"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NO_THROW(norm2tex::loadSensorModel(path("theirs.yaml")));
+
+  std::filesystem::create_directories(path("other"));
+  std::filesystem::copy_file(path("press1.png"), path("other/press1.png"));
+  const CliRun ambiguous =
+      calibrate("--background " + path("bg.png") + " --presses" + presses_ + " " +
+                path("other/press1.png") + " --ball-diameter-mm 6 --mm-per-pixel 0.054 --labels " +
+                path("their_labels.csv") + " -o " + path("x.yaml"));
+  EXPECT_EQ(ambiguous.exit_code, 1) << ambiguous.output;
+  EXPECT_NE(ambiguous.output.find("by base name"), std::string::npos) << ambiguous.output;
+  EXPECT_NE(ambiguous.output.find(path("other/press1.png")), std::string::npos) << ambiguous.output;
+  EXPECT_EQ(std::count(ambiguous.output.begin(), ambiguous.output.end(), '\n'), 1)
+      << ambiguous.output;
+}
+
+TEST_F(CalibrateCli, HelpPrintsTheUsageAndSucceeds) {
+  for (const std::string flag : {"--help", "-h"}) {
+    const CliRun run = calibrate(flag);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_EQ(run.output.rfind("usage: norm2tex_calibrate", 0), 0u) << run.output;
+  }
+}
+
 TEST_F(CalibrateCli, BadInputIsAOneLineErrorOrUsage) {
   const auto expectError = [&](const std::string& arguments, const std::string& fragment) {
     const CliRun run = calibrate(arguments);

@@ -1,8 +1,11 @@
 #pragma once
 // Hot loops written as plain C++ that the compiler vectorises are built twice on x86-64 with
 // GCC or Clang: for AVX2 (8 floats a step) and for the baseline (SSE2, 4); one is picked when the
-// library loads. Both do the same operations in the same order, and the package builds in ISO
-// C++ mode (no contraction into FMAs), so they give the same floats.
+// library loads. Both do the same operations in the same order and the core is built with
+// -ffp-contract=off (src/core/CMakeLists.txt), so they give the same floats. That flag is what
+// keeps a*b+c from becoming one fused multiply-add, which rounds once instead of twice: ISO
+// C++ mode does not (GCC contracts by default in every C++ mode; only ISO C forbids it), and
+// with -mfma or -march=native the compiler would emit vfmadd in one build and not the other.
 
 #if defined(__GNUC__)
 #define NORM2TEX_ALWAYS_INLINE __attribute__((always_inline)) inline

@@ -49,8 +49,11 @@ class TexturedMesh {
   const std::vector<Eigen::Vector2f>& uvs() const { return uvs_; }
   bool hasUvs() const { return !uvs_.empty(); }
   /// Absolute path of the normal texture the file's material references (glTF normalTexture,
-  /// OBJ norm, else OBJ map_Bump / bump), resolved against the mesh file's directory; from the
-  /// first mesh whose material has one. Empty when there is none or it is embedded in the file.
+  /// OBJ norm, else OBJ map_Bump / bump), from the first mesh whose material has one. Relative
+  /// references are resolved against the mesh file's directory, for an .obj first against the
+  /// directory of the .mtl that names it (where the file exists there). An .obj's .mtl is read
+  /// by the package itself, so the result is the same on every assimp release. Empty when there
+  /// is none or it is embedded in the file.
   const std::string& normalTexturePath() const { return normal_texture_path_; }
   /// The normal texture's reference as the file writes it ("textures/n.png", or "*0" for the
   /// first texture embedded in a GLB); empty when the material has none. For messages.

@@ -91,17 +91,19 @@ UvLayout computeUvLayout(const TexturedMesh& mesh, cv::Size size);
 /// empty or mismatched image, or texels < 0.
 cv::Mat1i padIslands(cv::Mat& image, const cv::Mat1i& island, int texels);
 
-/// Writes the mesh (positions, UVs when present, triangles) with assimp's Exporter; the format
-/// comes from the extension (case-insensitive): .obj, .ply (ASCII), .stl (binary, no UVs), .dae,
-/// .glb, .gltf (+ .bin next to it). UVs are written in each format's own convention, so
-/// TexturedMesh::load gives back the same UVs: glTF stores v downwards, and both assimp's glTF
-/// exporter and importer flip v (v_file = 1 - v), so the round trip is exact.
-/// A non-empty `normal_texture` is referenced by the material as a path relative to the file's
-/// directory (absolute when there is no relative path), so TexturedMesh::load finds it again:
-/// for .obj in <stem>.mtl (written, overwriting) with `map_Bump` and `norm`; for .dae, .glb and
-/// .gltf as the normal texture (glTF normalTexture, not embedded); .ply and .stl have no
-/// materials and drop it. Throws Error (naming the file) for an unknown extension, an unwritable
-/// path or an assimp failure.
+/// Writes the mesh (positions, UVs when present, triangles): glTF itself, the rest with assimp's
+/// Exporter. The format comes from the extension (case-insensitive): .obj, .ply (ASCII), .stl
+/// (binary, no UVs), .dae, .glb, .gltf (+ .bin next to it; embedded when the name needs URI
+/// escaping). UVs are written in each format's own convention, so TexturedMesh::load gives back the
+/// same UVs: glTF stores v downwards (v_file = 1 - v) and assimp's importer flips it back. glTF is
+/// written by the package itself (glTF 2.0, with vertex normals), not by assimp, whose exporter
+/// does not flip v before 5.1: the file is the same on every platform. A non-empty `normal_texture`
+/// is referenced by the material as a path relative to the file's directory (absolute when there is
+/// no relative path), so TexturedMesh::load finds it again: for .obj in <stem>.mtl (written,
+/// overwriting) with `map_Bump` and `norm`; for .dae, .glb and .gltf as the normal texture (glTF
+/// normalTexture, a percent-encoded URI, not embedded); .ply and .stl have no materials and drop
+/// it. Throws Error (naming the file) for an unknown extension, an unwritable path or an assimp
+/// failure.
 void saveMesh(const TexturedMesh& mesh, const std::string& path,
               const std::string& normal_texture = "");
 

@@ -60,7 +60,7 @@ inline double infillLine(double t, double floored) {
 // The row kernel: evaluate()'s arithmetic for up to kChunk texels of one row, split into loops
 // that vectorise (the arithmetic, five divisions a texel among it) and loops point by point
 // (lattice cells and hashes, cached as in evaluate). The same operations in the same order, so
-// the same bits: the package builds without FMA contraction (simd_dispatch.hpp). Per texel,
+// the same bits: the core builds with -ffp-contract=off (simd_dispatch.hpp). Per texel,
 // evaluate() took ~30 ns, a third of a 2048^2 variant's preparation.
 constexpr int kChunk = 256;
 

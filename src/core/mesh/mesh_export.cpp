@@ -1,4 +1,5 @@
-// saveMesh: TexturedMesh -> file through assimp's Exporter (and an OBJ material of our own).
+// saveMesh: TexturedMesh -> file through assimp's Exporter (and an OBJ material of our own),
+// glTF through our own writer (gltf_writer.hpp: assimp's differs between releases).
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -11,6 +12,7 @@
 #include <assimp/scene.h>
 #include <assimp/Exporter.hpp>
 
+#include "mesh/gltf_writer.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/mesh/uv_unwrap.hpp"
 
@@ -123,6 +125,12 @@ void saveMesh(const TexturedMesh& mesh, const std::string& path,
     throw Error("saveMesh: cannot write " + what + ": it is a directory");
   }
 
+  if (format == "glb2" || format == "gltf2") {
+    const std::string reference =
+        normal_texture.empty() ? std::string() : textureReference(normal_texture, directory);
+    detail::writeGltf(mesh, path, format == "glb2", reference, kMaterialName);
+    return;
+  }
   const std::unique_ptr<aiScene> scene = makeScene(mesh);
   if (!normal_texture.empty() && format != "obj") {
     const aiString reference(textureReference(normal_texture, directory));

@@ -1,9 +1,12 @@
 // TexturedMesh::load: assimp import, scene-graph flattening and normal texture lookup. Kept
 // apart from textured_mesh.cpp so only this file depends on assimp.
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <unordered_set>
@@ -17,6 +20,8 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include "mesh/gltf_writer.hpp"
+#include "mesh/mtl_file.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/mesh/textured_mesh.hpp"
 
@@ -55,27 +60,51 @@ std::string normalTextureOf(const aiMaterial* material) {
   return {};
 }
 
-// A texture reference made absolute against the mesh file's directory. Embedded textures
-// ("*0", data URIs) have no file: empty.
+bool isObjFile(const std::string& path) {
+  std::string extension = fs::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".obj";
+}
+
+// A material's name as assimp read it (OBJ: its newmtl name).
+std::string materialName(const aiMaterial* material) {
+  aiString name;
+  if (material == nullptr || material->Get(AI_MATKEY_NAME, name) != aiReturn_SUCCESS) return {};
+  return name.C_Str();
+}
+
+// A texture reference made absolute. `directories` are where a relative reference may be
+// relative to, most likely first (for an .obj: its .mtl's directory, then its own); the first
+// where the file exists wins, else the first. Embedded textures ("*0", data URIs) have no
+// file: empty.
 std::string resolveTexture(const std::string& reference, const aiScene& scene,
-                           const fs::path& mesh_directory) {
+                           const std::vector<fs::path>& directories) {
   if (reference.empty() || reference[0] == '*' || reference.rfind("data:", 0) == 0 ||
       scene.GetEmbeddedTexture(reference.c_str()) != nullptr) {
     return {};
   }
-  fs::path texture(reference);
-  std::error_code ec;
-  if (!texture.is_absolute() && !fs::exists(mesh_directory / texture, ec) &&
-      reference.find('\\') != std::string::npos) {
-    // Files exported on Windows: "textures\\normal.png".
+  const fs::path texture(reference);
+  if (texture.is_absolute()) return texture.lexically_normal().string();
+  // Spellings of the reference to try: as written; with Windows separators turned
+  // ("textures\\normal.png"); percent-decoded (glTF image URIs: "sphere%20normal.png"; not
+  // every assimp decodes them).
+  std::vector<fs::path> spellings{texture};
+  if (reference.find('\\') != std::string::npos) {
     std::string slashed = reference;
-    for (char& c : slashed) {
-      if (c == '\\') c = '/';
-    }
-    if (fs::exists(mesh_directory / slashed, ec)) texture = slashed;
+    std::replace(slashed.begin(), slashed.end(), '\\', '/');
+    spellings.emplace_back(slashed);
   }
-  if (!texture.is_absolute()) texture = mesh_directory / texture;
-  return texture.lexically_normal().string();
+  if (reference.find('%') != std::string::npos) {
+    spellings.emplace_back(detail::uriDecodePath(reference));
+  }
+  std::error_code ec;
+  for (const fs::path& directory : directories) {
+    for (const fs::path& spelling : spellings) {
+      if (fs::exists(directory / spelling, ec))
+        return (directory / spelling).lexically_normal().string();
+    }
+  }
+  return (directories.front() / texture).lexically_normal().string();
 }
 
 // The file bytes of an embedded texture ("*N" or a name assimp knows as embedded). Compressed
@@ -150,6 +179,10 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
   std::vector<Eigen::Vector2f> uvs;
   bool any_uvs = false;
   std::string texture_reference;
+  const fs::path mesh_directory = fs::absolute(fs::path(path), ec).parent_path();
+  std::vector<fs::path> texture_directories{mesh_directory};
+  // An .obj's material libraries as we read them (mtl_file.hpp), read once when needed.
+  std::optional<std::vector<detail::ObjMaterial>> obj_materials;
   std::vector<std::pair<const aiNode*, Eigen::Matrix4d>> pending{
       {scene->mRootNode, scale * toEigen(scene->mRootNode->mTransformation)}};
   std::unordered_set<const aiNode*> visited;
@@ -213,7 +246,22 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
       }
       if (texture_reference.empty() && mesh->mMaterialIndex < scene->mNumMaterials &&
           scene->mMaterials != nullptr) {
-        texture_reference = normalTextureOf(scene->mMaterials[mesh->mMaterialIndex]);
+        const aiMaterial* material = scene->mMaterials[mesh->mMaterialIndex];
+        texture_reference = normalTextureOf(material);
+        if (isObjFile(path)) {
+          // The .mtl as we read it decides, so an .obj finds the same texture on every assimp:
+          // < 5.1 skips `norm`, and releases differ on quoted names, option arguments and
+          // keyword case. assimp's reading stays for a material we cannot find by name.
+          if (!obj_materials) obj_materials = detail::readObjMaterials(path);
+          const detail::ObjMaterial* own =
+              detail::findObjMaterial(*obj_materials, materialName(material));
+          if (own != nullptr && !own->material.normalTexture().empty()) {
+            texture_reference = own->material.normalTexture();
+          }
+          if (own != nullptr && !texture_reference.empty()) {
+            texture_directories.insert(texture_directories.begin(), own->mtl_directory);
+          }
+        }
       }
     }
   }
@@ -228,8 +276,7 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
     if (detail.rfind("mesh: ", 0) == 0) detail.erase(0, 6);
     throw Error(what + ": " + detail);
   }
-  const fs::path directory = fs::absolute(fs::path(path), ec).parent_path();
-  result.normal_texture_path_ = resolveTexture(texture_reference, *scene, directory);
+  result.normal_texture_path_ = resolveTexture(texture_reference, *scene, texture_directories);
   result.normal_texture_reference_ = texture_reference;
   result.embedded_normal_texture_ = embeddedTexture(texture_reference, *scene);
   result.source_path_ = path;

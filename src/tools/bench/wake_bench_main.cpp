@@ -17,9 +17,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <cstdlib>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -118,9 +118,14 @@ std::vector<double> pipeHandOver(int frames, int sender_cpu, int receiver_cpu) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* const usage = "usage: norm2tex_wake_bench [FRAMES >= 10]\n";
+  if (argc > 1 && (std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "--help") == 0)) {
+    std::fputs(usage, stdout);
+    return 0;
+  }
   const int frames = argc > 1 ? std::atoi(argv[1]) : 1200;
-  if (frames < 10) {
-    std::fprintf(stderr, "usage: norm2tex_wake_bench [FRAMES >= 10]\n");
+  if (frames < 10 || argc > 2) {
+    std::fputs(usage, stderr);
     return 2;
   }
   const unsigned cpus = std::thread::hardware_concurrency();
