@@ -22,7 +22,7 @@
 
 namespace norm2tex {
 
-/// Validated private parameters of contact_sim (see README, "contact_sim").
+/// Validated private parameters of contact_sim (docs/ros.md, "contact_sim").
 struct ContactSimParams {
   bool synchronous = false;      ///< ~mode: "real_time" | "synchronous"
   std::string scene;             ///< ~scene: scene yaml

@@ -8,7 +8,7 @@
 
 namespace norm2tex {
 
-/// What norm2tex_export writes (see README, "Export for training").
+/// What norm2tex_export writes (docs/datasets.md, "Export and PyTorch").
 struct ExportOptions {
   std::string out_dir;
   bool force = false;                ///< write into a non-empty out_dir (files are replaced)

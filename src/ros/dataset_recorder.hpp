@@ -19,7 +19,7 @@
 
 namespace norm2tex {
 
-/// Validated private parameters of dataset_recorder (see README, "dataset_recorder").
+/// Validated private parameters of dataset_recorder (docs/ros.md, "dataset_recorder").
 struct DatasetRecorderParams {
   std::string output_dir;           ///< ~output_dir: created if missing; must be writable
   std::string prefix = "norm2tex";  ///< ~prefix: bags are <prefix>_shard<k>_<n>.bag

@@ -23,7 +23,7 @@
 
 namespace norm2tex {
 
-/// Validated private parameters of probe_sim (see README, "probe_sim").
+/// Validated private parameters of probe_sim (docs/ros.md, "probe_sim").
 struct ProbeSimParams {
   std::string sensor_name = "digit_left";  ///< ~sensor_name: the probing DIGIT
   std::string sensor;                      ///< ~sensor: sensor yaml

@@ -22,7 +22,7 @@
 
 namespace norm2tex {
 
-/// Validated private parameters of tactile_renderer (see README, "tactile_renderer").
+/// Validated private parameters of tactile_renderer (docs/ros.md, "tactile_renderer").
 struct TactileRendererParams {
   std::string sensor_name = "digit_left";  ///< ~sensor_name: topic namespace of the sensor
   std::string sensor;                      ///< ~sensor: sensor yaml

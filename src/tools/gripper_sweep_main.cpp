@@ -1,5 +1,5 @@
 // norm2tex_gripper_sweep: squeezes each scene's object harder and harder and plots what the
-// gels feel against the configured gel law (the README's physics figure).
+// gels feel against the configured gel law (the physics figure of docs/physics.md).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,6 @@
 // norm2tex_texgen: procedural material -> normal map (+ albedo, height, UV-unwrapped mesh),
-// material variants, and the README's gallery of every material through the tactile renderer.
+// material variants, and the gallery of every material through the tactile renderer
+// (docs/materials.md).
 #include <algorithm>
 #include <chrono>
 #include <cmath>

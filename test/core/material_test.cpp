@@ -495,7 +495,7 @@ TEST(Material, ParameterValidationNamesTheChoices) {
 }
 
 TEST(Material, TimingsOf2048Textures) {
-  // No assertion: printed for the report and the README (Release, one core).
+  // No assertion: printed for docs/performance.md (Release, one core).
   for (const std::string& name : materialNames()) {
     const auto material = makeMaterial(name);
     const auto start = std::chrono::steady_clock::now();

@@ -190,7 +190,7 @@ std::string shadingFeatureNames() {
 
 std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse() {
   // Fitted by norm2tex_calibrate on digit_calibration_s09 (see config/digit.yaml, which holds
-  // the same numbers, and README "Calibrate your own DIGIT").
+  // the same numbers, and docs/calibration.md).
   // Rows B, G, R; columns in the order of shadingFeatureNames().
   return {{{{// blue
              -1.7029, -27.0042, -22.5671,  8.1038,   50.1430,  1.2310,   -14.0443, -29.4138,

@@ -1,0 +1,438 @@
+#!/usr/bin/env python3
+"""The documentation against the package: README.md and docs/*.md cannot name what is not there.
+
+  - every relative link and image resolves (files, and #anchors to headings of .md pages);
+  - every `roslaunch norm2tex X.launch arg:=v` shown names an existing launch file and args it has;
+  - every `rosrun norm2tex T` names a program CMakeLists.txt installs;
+  - every `norm2tex/XNodelet` named is exported in nodelet_plugins.xml;
+  - the parameter tables of docs/ros.md ("private parameter" tables under a node's heading) list
+    exactly the private parameters the node's code reads (pnh.param / getParam in src/ros/), and
+    the launch-argument tables ("launch arg" tables under a launch file's heading) exactly the
+    arguments the launch file takes.
+
+Usage: test_docs.py [PACKAGE_ROOT]   (default: two folders up). Stdlib only.
+"""
+import os
+import re
+import sys
+import unittest
+import xml.etree.ElementTree as ET
+
+ROOT = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else
+                       os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+
+# Which sources hold each node's parameter reads (the node's own reader and what it calls).
+NODE_SOURCES = {
+    "contact_sim": ["contact_sim.cpp"],
+    "tactile_renderer": ["tactile_renderer_ros.cpp"],
+    "probe_sim": ["probe_sim.cpp"],
+    "dataset_recorder": ["dataset_recorder.cpp", "nodelets.cpp"],
+    "nodelet_group": ["nodelet_group_main.cpp"],
+}
+# Readers shared by several nodes: included where a node's source calls them.
+SHARED_READERS = {"readLockStepParams": "lock_step.cpp"}
+
+
+def read(path):
+    with open(path, encoding="utf-8") as f:
+        return f.read()
+
+
+def pages(root=ROOT):
+    """README.md and docs/*.md, as (path, text)."""
+    paths = [os.path.join(root, "README.md")]
+    docs = os.path.join(root, "docs")
+    if os.path.isdir(docs):
+        paths += sorted(os.path.join(docs, f) for f in os.listdir(docs) if f.endswith(".md"))
+    return [(p, read(p)) for p in paths if os.path.exists(p)]
+
+
+# --- Markdown pieces -----------------------------------------------------------------------------
+_FENCE = re.compile(r"^(```|~~~)")
+
+
+def split_code(text):
+    """(prose with code removed, list of code segments): fenced blocks' logical lines (a trailing
+    backslash joins the next line) and inline code spans (newlines as spaces)."""
+    prose, code, block, in_fence = [], [], [], False
+    for line in text.split("\n"):
+        if _FENCE.match(line.strip()):
+            if in_fence:
+                code += _logical_lines(block)
+                block = []
+            in_fence = not in_fence
+            prose.append("")
+            continue
+        (block if in_fence else prose).append(line)
+    if in_fence:
+        code += _logical_lines(block)
+    prose_text = "\n".join(prose)
+    for span in re.findall(r"(`+)(.+?)\1", prose_text, flags=re.S):
+        code.append(span[1].replace("\n", " "))
+    prose_text = re.sub(r"(`+)(.+?)\1", " ", prose_text, flags=re.S)
+    return prose_text, code
+
+
+def _logical_lines(lines):
+    out, cur = [], ""
+    for line in lines:
+        if line.rstrip().endswith("\\"):
+            cur += line.rstrip()[:-1] + " "
+        else:
+            out.append(cur + line)
+            cur = ""
+    if cur:
+        out.append(cur)
+    return out
+
+
+def _strip_comment(line):
+    return re.split(r"\s#\s", " " + line, maxsplit=1)[0]
+
+
+def slug(heading):
+    """GitHub's anchor for a heading's text."""
+    text = re.sub(r"[`*_]{2,}|`", "", heading).strip().lower()
+    text = re.sub(r"[^\w\- ]", "", text)
+    return text.replace(" ", "-")
+
+
+def anchors(text):
+    prose, _ = split_code_keep_headings(text)
+    seen, out = {}, set()
+    for line in prose.split("\n"):
+        m = re.match(r"^#{1,6}\s+(.*?)\s*#*\s*$", line)
+        if not m:
+            continue
+        base = slug(m.group(1))
+        n = seen.get(base, 0)
+        out.add(base if n == 0 else "%s-%d" % (base, n))
+        seen[base] = n + 1
+    return out
+
+
+def split_code_keep_headings(text):
+    """Text without fenced blocks (headings keep their inline code)."""
+    lines, in_fence = [], False
+    for line in text.split("\n"):
+        if _FENCE.match(line.strip()):
+            in_fence = not in_fence
+            continue
+        if not in_fence:
+            lines.append(line)
+    return "\n".join(lines), None
+
+
+def links(text):
+    """Targets of Markdown links and images and of HTML src/href, outside code."""
+    prose, _ = split_code(text)
+    out = re.findall(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)", prose)
+    out += re.findall(r"\b(?:src|href)\s*=\s*\"([^\"]+)\"", prose)
+    return out
+
+
+def check_links(path, text, root=ROOT):
+    errors = []
+    for target in links(text):
+        if re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*:", target):  # http:, mailto:, ...
+            continue
+        file_part, _, fragment = target.partition("#")
+        resolved = path if not file_part else os.path.normpath(
+            os.path.join(os.path.dirname(path), file_part))
+        where = os.path.relpath(path, root)
+        if not os.path.exists(resolved):
+            errors.append("%s: link '%s' does not resolve" % (where, target))
+            continue
+        if fragment and resolved.endswith(".md"):
+            if fragment not in anchors(read(resolved)):
+                errors.append("%s: link '%s': no heading '#%s' in %s" %
+                              (where, target, fragment, os.path.relpath(resolved, root)))
+    return errors
+
+
+# --- roslaunch, rosrun, nodelets ----------------------------------------------------------------
+_ROSLAUNCH = re.compile(r"\broslaunch\s+(?:-\S+\s+(?:\S+\s+)?)*?norm2tex\s+([\w./-]+\.launch)\b(.*)")
+_ROSRUN = re.compile(r"\brosrun\s+norm2tex\s+([\w./-]+)")
+
+
+def roslaunch_uses(text):
+    """(launch file, [arg names]) for every `roslaunch norm2tex X.launch a:=v ...` in code."""
+    uses = []
+    for segment in split_code(text)[1]:
+        for line in segment.split("\n"):
+            line = _strip_comment(line)
+            for m in _ROSLAUNCH.finditer(line):
+                rest = re.split(r"\s(?:&&|\|\||;|\|)\s|\broslaunch\b|\brosrun\b", m.group(2))[0]
+                uses.append((m.group(1), re.findall(r"(?<![\w$(])([A-Za-z_]\w*):=", rest)))
+    return uses
+
+
+def rosrun_uses(text):
+    out = []
+    for segment in split_code(text)[1]:
+        out += _ROSRUN.findall(_strip_comment(segment))
+    return out
+
+
+def launch_args(launch_path):
+    """Arguments a user can set on a launch file: its top-level <arg>s without value=."""
+    tree = ET.parse(launch_path)
+    return {a.get("name") for a in tree.getroot().findall("arg") if a.get("value") is None}
+
+
+def installed_programs(cmake_text):
+    """What `rosrun norm2tex NAME` finds after `catkin_make install`."""
+    text = re.sub(r"#.*", "", cmake_text)
+    programs = set()
+    lists = {}
+    for m in re.finditer(r"\bset\s*\(\s*(\w+)\s+([^)]*)\)", text):
+        lists[m.group(1)] = m.group(2).split()
+    for m in re.finditer(r"\blist\s*\(\s*APPEND\s+(\w+)\s+([^)]*)\)", text):
+        lists.setdefault(m.group(1), []).extend(m.group(2).split())
+    for m in re.finditer(r"\binstall\s*\(\s*TARGETS\s+([^)]*)\)", text):
+        body = m.group(1)
+        if "CATKIN_PACKAGE_BIN_DESTINATION" not in body:
+            continue
+        for word in body.split("RUNTIME")[0].split():
+            var = re.match(r"\$\{(\w+)\}", word)
+            programs.update(lists.get(var.group(1), []) if var else [word])
+    for m in re.finditer(r"\binstall\s*\(\s*PROGRAMS\s+([^)]*)\)", text):
+        files, _, dest = m.group(1).partition("DESTINATION")
+        sub = re.match(r"\s*\$\{CATKIN_PACKAGE_BIN_DESTINATION\}(?:/(\S+))?", dest)
+        if not sub:
+            continue
+        for f in files.split():
+            name = os.path.basename(f)
+            programs.add(sub.group(1) + "/" + name if sub.group(1) else name)
+    return programs
+
+
+def exported_nodelets(plugins_xml):
+    return {c.get("name") for c in ET.parse(plugins_xml).getroot().iter("class")}
+
+
+# --- reference tables ---------------------------------------------------------------------------
+def tables(text):
+    """(heading, header cells, [rows of cells]) for every Markdown table outside code."""
+    out, heading = [], ""
+    lines = split_code_keep_headings(text)[0].split("\n")
+    i = 0
+    while i < len(lines):
+        line = lines[i]
+        if re.match(r"^#{1,6}\s", line):
+            heading = line
+        if line.lstrip().startswith("|") and i + 1 < len(lines) and \
+                re.match(r"^\s*\|[\s:|-]+\|\s*$", lines[i + 1]):
+            header = _cells(line)
+            rows = []
+            i += 2
+            while i < len(lines) and lines[i].lstrip().startswith("|"):
+                rows.append(_cells(lines[i]))
+                i += 1
+            out.append((heading, header, rows))
+            continue
+        i += 1
+    return out
+
+
+def _cells(line):
+    line = line.strip().replace("\\|", "\x00")
+    return [c.strip().replace("\x00", "|") for c in line.strip("|").split("|")]
+
+
+def _ticked(cell):
+    return re.findall(r"`([^`]+)`", cell)
+
+
+def documented_params(text):
+    """{node: set of parameter names} from "private parameter" tables under a node's heading."""
+    out = {}
+    for heading, header, rows in tables(text):
+        if not header or header[0].lower() != "private parameter":
+            continue
+        names = _ticked(heading)
+        node = names[0] if names else heading
+        params = out.setdefault(node, set())
+        for row in rows:
+            params.update(t[1:] for t in _ticked(row[0]) if t.startswith("~"))
+    return out
+
+
+def documented_launch_args(text):
+    """{launch file: set of args} from "launch arg" tables under a launch file's heading."""
+    out = {}
+    for heading, header, rows in tables(text):
+        if not header or header[0].lower() != "launch arg":
+            continue
+        launch = next((t for t in _ticked(heading) if t.endswith(".launch")), heading)
+        args = out.setdefault(launch, set())
+        for row in rows:
+            args.update(_ticked(row[0]))
+    return out
+
+
+_READ = re.compile(r"\b(?:pnh|private_nh_?|getPrivateNodeHandle\(\))\s*\.\s*"
+                   r"(?:param|getParam|getParamCached|hasParam|searchParam)\b\s*"
+                   r"(?:<[^;()]*>)?\s*\(\s*\"([^\"]+)\"")
+
+
+def params_read(source_text):
+    return set(_READ.findall(re.sub(r"//.*", "", source_text)))
+
+
+def code_params(ros_dir):
+    """{node: set of private parameters its code reads}, and the files with reads no node owns."""
+    reads = {f: params_read(read(os.path.join(ros_dir, f)))
+            for f in sorted(os.listdir(ros_dir)) if f.endswith(".cpp")}
+    out = {}
+    for node, files in NODE_SOURCES.items():
+        params = set()
+        for f in files:
+            params |= reads.get(f, set())
+            text = read(os.path.join(ros_dir, f))
+            for reader, shared in SHARED_READERS.items():
+                if re.search(r"\b%s\s*\(" % reader, text):
+                    params |= reads.get(shared, set())
+        out[node] = params
+    owned = {f for files in NODE_SOURCES.values() for f in files} | set(SHARED_READERS.values())
+    unowned = sorted(f for f, names in reads.items() if names and f not in owned)
+    return out, unowned
+
+
+def compare(what, documented, actual):
+    errors = []
+    for name in sorted(documented - actual):
+        errors.append("%s: '%s' is documented but not in the code" % (what, name))
+    for name in sorted(actual - documented):
+        errors.append("%s: '%s' is in the code but not documented" % (what, name))
+    return errors
+
+
+# --- the checks over a package ------------------------------------------------------------------
+def check_package(root=ROOT, page_list=None):
+    """Every problem found, as one-line messages."""
+    page_list = pages(root) if page_list is None else page_list
+    errors = []
+    programs = installed_programs(read(os.path.join(root, "CMakeLists.txt")))
+    nodelets = exported_nodelets(os.path.join(root, "nodelet_plugins.xml"))
+    for path, text in page_list:
+        where = os.path.relpath(path, root)
+        errors += check_links(path, text, root)
+        for launch, args in roslaunch_uses(text):
+            launch_path = os.path.join(root, "launch", launch)
+            if not os.path.exists(launch_path):
+                errors.append("%s: roslaunch norm2tex %s: no such launch file" % (where, launch))
+                continue
+            for arg in sorted(set(args) - launch_args(launch_path)):
+                errors.append("%s: roslaunch norm2tex %s: no arg '%s'" % (where, launch, arg))
+        for program in rosrun_uses(text):
+            if program not in programs:
+                errors.append("%s: rosrun norm2tex %s: not installed by CMakeLists.txt" %
+                              (where, program))
+        for nodelet in re.findall(r"\bnorm2tex/\w+Nodelet\b", text):
+            if nodelet not in nodelets:
+                errors.append("%s: %s is not exported in nodelet_plugins.xml" % (where, nodelet))
+        for launch, args in documented_launch_args(text).items():
+            launch_path = os.path.join(root, "launch", launch)
+            if not os.path.exists(launch_path):
+                errors.append("%s: table of %s: no such launch file" % (where, launch))
+                continue
+            errors += compare("%s: %s args" % (where, launch), args, launch_args(launch_path))
+        documented = documented_params(text)
+        if documented:
+            actual, unowned = code_params(os.path.join(root, "src", "ros"))
+            for node, params in documented.items():
+                if node not in actual:
+                    errors.append("%s: parameter table of '%s': no such node" % (where, node))
+                    continue
+                errors += compare("%s: %s parameters" % (where, node), params, actual[node])
+            for node in sorted(set(actual) - set(documented)):
+                errors.append("%s: node '%s' has no parameter table" % (where, node))
+            for f in unowned:
+                errors.append("src/ros/%s reads private parameters of a node the docs check "
+                              "does not know (add it to NODE_SOURCES)" % f)
+    return errors
+
+
+class DocsTest(unittest.TestCase):
+    """The shipped README.md and docs/ against the package."""
+
+    def test_pages_exist(self):
+        names = [os.path.relpath(p, ROOT) for p, _ in pages()]
+        self.assertIn("README.md", names)
+        self.assertIn(os.path.join("docs", "ros.md"), names)
+
+    def test_docs_match_the_package(self):
+        errors = check_package()
+        self.assertEqual(errors, [], "\n" + "\n".join(errors))
+
+    def test_ros_md_has_every_node_table(self):
+        ros_md = read(os.path.join(ROOT, "docs", "ros.md"))
+        self.assertEqual(set(documented_params(ros_md)), set(NODE_SOURCES))
+        self.assertEqual(set(documented_launch_args(ros_md)),
+                         {"gripper_sim.launch", "record_dataset.launch"})
+
+
+class CheckerCatchesBrokenPages(unittest.TestCase):
+    """The check itself: a page naming something that is not there fails it."""
+
+    def broken(self, text):
+        path = os.path.join(ROOT, "docs", "broken_example.md")
+        return check_package(ROOT, [(path, text)])
+
+    def test_good_page_passes(self):
+        self.assertEqual(self.broken(
+            "See [ros](ros.md#frames) and ![x](images/rviz.png).\n\n"
+            "```bash\nroslaunch norm2tex gripper_sim.launch mode:=synchronous  # ok:=no\n"
+            "rosrun norm2tex norm2tex_bake in.png -o out.tiff\n"
+            "rosrun norm2tex slurm/submit_dataset 2 /tmp/x\n```\n"), [])
+
+    def test_missing_file_link_and_image(self):
+        errors = self.broken("[a](nowhere.md) ![b](images/missing.png)\n")
+        self.assertEqual(len(errors), 2, errors)
+
+    def test_missing_anchor(self):
+        self.assertEqual(len(self.broken("[a](ros.md#no-such-heading)\n")), 1)
+
+    def test_links_in_code_are_not_links(self):
+        self.assertEqual(self.broken("`[a](nowhere.md)`\n"), [])
+
+    def test_roslaunch_missing_file_and_arg(self):
+        errors = self.broken("```bash\nroslaunch norm2tex nope.launch\n"
+                             "roslaunch norm2tex gripper_sim.launch mode:=synchronous colour:=red\n```\n"
+                             "Inline: `roslaunch norm2tex record_dataset.launch out:=/x sample:=3`.\n")
+        self.assertEqual(len(errors), 3, errors)
+        self.assertTrue(any("'colour'" in e for e in errors))
+        self.assertTrue(any("'sample'" in e for e in errors))
+
+    def test_rosrun_not_installed(self):
+        errors = self.broken("```bash\nrosrun norm2tex quickstart run\n"
+                             "rosrun norm2tex norm2tex_frobnicate\n```\n")
+        self.assertEqual(len(errors), 2, errors)
+
+    def test_unknown_nodelet(self):
+        self.assertEqual(len(self.broken("`norm2tex/FooNodelet`\n")), 1)
+
+    def test_param_table_drift(self):
+        page = ("## `contact_sim` (node)\n\n| private parameter | default | meaning |\n|---|---|---|\n"
+                "| `~mode` | real_time | |\n| `~colour` | red | |\n")
+        errors = [e for e in self.broken(page) if "contact_sim parameters" in e]
+        self.assertTrue(any("'colour' is documented but not in the code" in e for e in errors))
+        self.assertTrue(any("'scene' is in the code but not documented" in e for e in errors))
+
+    def test_launch_table_drift(self):
+        page = ("## `gripper_sim.launch`\n\n| launch arg | default | meaning |\n|---|---|---|\n"
+                "| `mode` | real_time | |\n| `colour` | red | |\n")
+        errors = self.broken(page)
+        self.assertTrue(any("'colour' is documented but not in the code" in e for e in errors))
+        self.assertTrue(any("'material' is in the code but not documented" in e for e in errors))
+
+    def test_code_reads_are_found(self):
+        src = ('pnh.param<std::string>("a", x, "d");\n  pnh.param("b", y, 1);\n'
+               'if (!pnh.getParam("c", z)) {}\n getPrivateNodeHandle().param("d", w, true);\n'
+               '// pnh.param("commented", q, 0);\n nh_.param("global", g, 0);\n')
+        self.assertEqual(params_read(src), {"a", "b", "c", "d"})
+
+
+if __name__ == "__main__":
+    unittest.main(argv=sys.argv[:1])
