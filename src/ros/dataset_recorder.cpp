@@ -71,32 +71,14 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
   openNextBag();
 
   answer_pub_ = nh_.advertise<FrameRendered>(params_.answer_topic, 100, /*latch=*/true);
-  // Deep queues: in real time a slow disk must not drop frames unnoticed (drops are counted
-  // as received - written at the end).
   std::vector<std::string> topics = params_.topics;
-  for (const std::string& topic : topics) {
-    const std::string resolved = nh_.resolveName(topic);
-    if (endsWith(topic, "/background")) {
-      // Typed: roscpp before 1.15.10 (Debian 11) does not deliver a latched message published
-      // in the same nodelet manager to a ShapeShifter subscriber; a typed one gets it.
-      subs_.push_back(nh_.subscribe<sensor_msgs::Image>(
-          topic, 10, [this, resolved](const ros::MessageEvent<sensor_msgs::Image const>& e) {
-            onLatchedImage(resolved, e);
-          }));
-      continue;
-    }
-    subs_.push_back(nh_.subscribe<topic_tools::ShapeShifter>(
-        topic, 1000, [this, resolved](const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
-          onMessage(resolved, e);
-        }));
-  }
   // The per-frame topics typed: in a nodelet manager they arrive without a copy, and their
   // stamps are read without deserialising them again.
   auto subscribePart = [&](const std::string& topic, auto tag) {
     using Message = typename decltype(tag)::type;
     const std::string resolved = nh_.resolveName(topic);
     topics.push_back(topic);
-    subs_.push_back(nh_.subscribe<Message>(
+    part_subs_.push_back(nh_.subscribe<Message>(
         topic, 1000, [this, resolved](const ros::MessageEvent<Message const>& e) {
           onFramePart(resolved, e.getConstMessage()->header.stamp,
                       [&](const ros::Time& when) {
@@ -110,8 +92,14 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
     subscribePart(sensor + "/depth", MessageTag<sensor_msgs::Image>());
     subscribePart(sensor + "/contact", MessageTag<TactileContact>());
   }
-  episode_sub_ = nh_.subscribe("episode", 10, &DatasetRecorder::onEpisode, this);
   frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &DatasetRecorder::onFrame, this);
+  // The extra topics and the episodes are subscribed once the constructor (a nodelet's onInit)
+  // has returned: nodelet 1.10 (Debian 11) loses a latched message (the renderers' background,
+  // /tf_static) that reaches a subscriber while onInit still runs, and that subscriber never
+  // fires again (nodelet_core issue 108).
+  subscribe_timer_ = nh_.createWallTimer(
+      ros::WallDuration(0.001), [this](const ros::WallTimerEvent&) { subscribeExtraTopics(); },
+      /*oneshot=*/true);
   started_ = last_progress_ = ros::WallTime::now();
   if (!params_.answer_as.empty()) {
     ready_timer_ = nh_.createWallTimer(ros::WallDuration(0.02),
@@ -128,13 +116,27 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
 DatasetRecorder::~DatasetRecorder() { close(); }
 
+void DatasetRecorder::subscribeExtraTopics() {
+  // Deep queues: in real time a slow disk must not drop frames unnoticed (drops are counted
+  // as received - written at the end).
+  for (const std::string& topic : params_.topics) {
+    const std::string resolved = nh_.resolveName(topic);
+    extra_subs_.push_back(nh_.subscribe<topic_tools::ShapeShifter>(
+        topic, 1000, [this, resolved](const ros::MessageEvent<topic_tools::ShapeShifter>& e) {
+          onMessage(resolved, e);
+        }));
+  }
+  episode_sub_ = nh_.subscribe("episode", 10, &DatasetRecorder::onEpisode, this);
+  extras_subscribed_ = true;
+}
+
 void DatasetRecorder::announceReady() {
   // "Ready" only once the per-frame topics and the frames are connected: a synchronous source
   // starts at that answer, and a message published before a connection exists is lost.
+  if (!extras_subscribed_) return;
   std::string unconnected;
-  const std::size_t extra = params_.topics.size();
-  for (std::size_t i = extra; i < subs_.size(); ++i) {
-    if (subs_[i].getNumPublishers() == 0) unconnected += " " + subs_[i].getTopic();
+  for (const ros::Subscriber& sub : part_subs_) {
+    if (sub.getNumPublishers() == 0) unconnected += " " + sub.getTopic();
   }
   if (frame_sub_.getNumPublishers() == 0) unconnected += " " + frame_sub_.getTopic();
   const ros::WallTime now = ros::WallTime::now();
@@ -145,8 +147,8 @@ void DatasetRecorder::announceReady() {
   // Extra topics (TF, clock, joints) may legitimately have no publisher: a short grace period.
   if (connected_since_.isZero()) connected_since_ = now;
   std::string optional;
-  for (std::size_t i = 0; i < extra; ++i) {
-    if (subs_[i].getNumPublishers() == 0) optional += " " + subs_[i].getTopic();
+  for (const ros::Subscriber& sub : extra_subs_) {
+    if (sub.getNumPublishers() == 0) optional += " " + sub.getTopic();
   }
   if (!optional.empty() && (now - connected_since_).toSec() < 1.0) return;
   if (!optional.empty()) {
@@ -231,13 +233,6 @@ void DatasetRecorder::onMessage(const std::string& topic,
     return;
   }
   if (params_.split_mb > 0.0 && bag_->getSize() > params_.split_mb * 1e6) openNextBag();
-}
-
-void DatasetRecorder::onLatchedImage(const std::string& topic,
-                                     const ros::MessageEvent<sensor_msgs::Image const>& e) {
-  write(topic, [&](const ros::Time& when) {
-    bag_->write(topic, when, e.getConstMessage(), e.getConnectionHeaderPtr());
-  });
 }
 
 void DatasetRecorder::onFramePart(const std::string& topic, const ros::Time& stamp,

@@ -10,7 +10,6 @@
 
 #include <ros/ros.h>
 #include <rosbag/bag.h>
-#include <sensor_msgs/Image.h>
 #include <topic_tools/shape_shifter.h>
 
 #include "norm2tex/EpisodeInfo.h"
@@ -69,9 +68,8 @@ class DatasetRecorder {
   bool write(const std::string& topic, const std::function<void(const ros::Time&)>& write_message);
   /// Extra topics (TF, clock, joints, labels), as they come.
   void onMessage(const std::string& topic, const ros::MessageEvent<topic_tools::ShapeShifter>& e);
-  /// The sensors' no-contact frames (latched), subscribed typed.
-  void onLatchedImage(const std::string& topic,
-                      const ros::MessageEvent<sensor_msgs::Image const>& e);
+  /// Subscribes ~topics and the episodes (after construction, see the constructor).
+  void subscribeExtraTopics();
   /// The sensors' per-frame topics: written, then counted towards their frame (`stamp`).
   void onFramePart(const std::string& topic, const ros::Time& stamp,
                    const std::function<void(const ros::Time&)>& write_message);
@@ -113,10 +111,12 @@ class DatasetRecorder {
   ros::WallTime started_, last_progress_;
 
   ros::NodeHandle nh_;
-  std::vector<ros::Subscriber> subs_;
+  std::vector<ros::Subscriber> extra_subs_;  ///< ~topics
+  std::vector<ros::Subscriber> part_subs_;   ///< the sensors' per-frame topics
+  bool extras_subscribed_ = false;
   ros::Subscriber frame_sub_, episode_sub_;
   ros::Publisher answer_pub_;
-  ros::WallTimer ready_timer_;
+  ros::WallTimer ready_timer_, subscribe_timer_;
   ros::WallTime connected_since_;
 };
 

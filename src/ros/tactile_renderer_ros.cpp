@@ -132,18 +132,12 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   if (params_.publish_mask) {
     mask_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/contact_mask", queue);
   }
-  // The no-contact frame (without noise), what background-subtracted datasets subtract: handed
-  // to each subscriber as it connects, as a latched topic would. Not latched: roscpp 1.15.9
-  // (Debian 11) never delivers a latched message to a subscriber in the same nodelet manager;
-  // a connect callback reaches every subscriber on every roscpp.
+  // The no-contact frame (without noise), latched: what background-subtracted datasets subtract.
+  background_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/background", 1, /*latch=*/true);
   std_msgs::Header background_header;
   background_header.frame_id = params_.gel_frame;
-  background_msg_ = ros_conversions::toImageMsg(background_header, renderer_->shader().background());
-  background_pub_ = nh_.advertise<sensor_msgs::Image>(
-      ns + "/background", 1,
-      [background = background_msg_](const ros::SingleSubscriberPublisher& subscriber) {
-        subscriber.publish(*background);
-      });
+  background_pub_.publish(
+      ros_conversions::toImageMsg(background_header, renderer_->shader().background()));
   // Frames in order, none dropped by the subscriber: synchronous mode sends one at a time, real
   // time at most a few behind. The answer topic comes last: contact_sim takes it as "ready".
   // They are handled on a thread of this renderer's own, woken by the frame itself: through a

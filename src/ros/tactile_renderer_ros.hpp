@@ -7,7 +7,6 @@
 #include <string>
 
 #include <image_transport/image_transport.h>
-#include <sensor_msgs/Image.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
@@ -22,7 +21,7 @@
 
 namespace norm2tex {
 
-/// Validated private parameters of tactile_renderer (docs/ros.md, "tactile_renderer").
+/// Validated private parameters of tactile_renderer (see README, "tactile_renderer").
 struct TactileRendererParams {
   std::string sensor_name = "digit_left";  ///< ~sensor_name: topic namespace of the sensor
   std::string sensor;                      ///< ~sensor: sensor yaml
@@ -107,8 +106,6 @@ class TactileRendererRos {
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
   ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;
-  /// The no-contact frame, sent to each subscriber of background_pub_ as it connects.
-  sensor_msgs::ImageConstPtr background_msg_;
   /// The frames' queue, served by frame_spinner_; declared before the subscription on it.
   ros::CallbackQueue frame_queue_;
   ros::Subscriber frame_sub_;
