@@ -93,18 +93,20 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
     subscribePart(sensor + "/contact", MessageTag<TactileContact>());
   }
   frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &DatasetRecorder::onFrame, this);
-  // The extra topics and the episodes are subscribed once the constructor (a nodelet's onInit)
-  // has returned: nodelet 1.10 (Debian 11) loses a latched message (the renderers' background,
-  // /tf_static) that reaches a subscriber while onInit still runs, and that subscriber never
-  // fires again (nodelet_core issue 108).
-  subscribe_timer_ = nh_.createWallTimer(
-      ros::WallDuration(0.001), [this](const ros::WallTimerEvent&) { subscribeExtraTopics(); },
-      /*oneshot=*/true);
   started_ = last_progress_ = ros::WallTime::now();
-  if (!params_.answer_as.empty()) {
-    ready_timer_ = nh_.createWallTimer(ros::WallDuration(0.02),
-                                       [this](const ros::WallTimerEvent&) { announceReady(); });
-  }
+  // The extra topics and the episodes are subscribed from this timer, once the constructor (a
+  // nodelet's onInit) has returned: nodelet 1.10 (Debian 11) loses a latched message (the
+  // renderers' background, /tf_static) that reaches a subscriber while onInit still runs, and
+  // that subscriber never fires again (nodelet_core issue 108). Then, in synchronous mode, the
+  // same timer announces "ready" once everything is connected.
+  ready_timer_ = nh_.createWallTimer(ros::WallDuration(0.02), [this](const ros::WallTimerEvent&) {
+    if (!extras_subscribed_) subscribeExtraTopics();
+    if (params_.answer_as.empty()) {
+      ready_timer_.stop();
+      return;
+    }
+    announceReady();
+  });
   // ~samples 0 is no limit of the recorder's own: the frame source's plan decides (probe_sim
   // ends with its last frame), so say that rather than "target 0".
   const std::string until = params_.samples > 0
@@ -133,7 +135,6 @@ void DatasetRecorder::subscribeExtraTopics() {
 void DatasetRecorder::announceReady() {
   // "Ready" only once the per-frame topics and the frames are connected: a synchronous source
   // starts at that answer, and a message published before a connection exists is lost.
-  if (!extras_subscribed_) return;
   std::string unconnected;
   for (const ros::Subscriber& sub : part_subs_) {
     if (sub.getNumPublishers() == 0) unconnected += " " + sub.getTopic();

@@ -116,7 +116,7 @@ class DatasetRecorder {
   bool extras_subscribed_ = false;
   ros::Subscriber frame_sub_, episode_sub_;
   ros::Publisher answer_pub_;
-  ros::WallTimer ready_timer_, subscribe_timer_;
+  ros::WallTimer ready_timer_;
   ros::WallTime connected_since_;
 };
 
