@@ -127,9 +127,11 @@ class GripperSim {
   /// `gel_index` and the object.
   template <typename Visit>
   void forEachGelPoint(int gel_index, Visit visit) const;
+  void dropContactsOffTheObject();
   void updateGelStiffness();
   void measureContacts(double dt);
   double objectWidthM() const;
+  double objectMinHalfSizeM() const;
 
   GripperSimConfig config_;
   ObjectMesh object_;

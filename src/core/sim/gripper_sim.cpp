@@ -23,6 +23,9 @@ constexpr double kHullMargin = 2e-5;
 constexpr double kSeatClearance = 1e-3;
 // After the fingers reach the grasp command, the contact settles this long before gravity.
 constexpr double kGraspHoldS = 0.1;
+// A gel contact point whose object-side point lies farther than this outside the object's
+// collision shape is not a contact (see dropContactsOffTheObject).
+constexpr double kOffObjectTolerance = 5e-5;
 
 btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
 Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
@@ -85,7 +88,9 @@ std::vector<std::unique_ptr<btCollisionShape>> makeObjectShapes(const ObjectMesh
   if (collision == "decomposition") return decomposeConvex(object.mesh, centre, kHullMargin);
   // Spheres take their mesh's hull too (within 5 um of the sphere at 96 x 192): Bullet's
   // sphere-box contact is a single point that did not hold a pinched ball (it slid 7 mm
-  // under its own weight at 2.6 N of grip), while the polyhedral hull holds it still.
+  // under its own weight at 2.6 N of grip), while the polyhedral hull holds it still. (The
+  // hull too touches each gel at one vertex; the gel's torsional friction keeps it from
+  // spinning, see updateGelStiffness.)
   // Convex hull of the render mesh's vertices about the body origin, reduced by btShapeHull
   // so contact generation stays cheap for big meshes.
   btConvexHullShape full;
@@ -104,6 +109,36 @@ std::vector<std::unique_ptr<btCollisionShape>> makeObjectShapes(const ObjectMesh
   hull->setMargin(kHullMargin);
   shapes.push_back(std::move(hull));
   return shapes;
+}
+
+// How far (m) a point in the object's body frame lies outside its collision shape, at least:
+// the largest p.u - h(u) over the point's own direction and the six axes, h the shape's
+// support function (margin included). Never positive for a point on or in the shape; part is
+// the compound child the point is on.
+double distanceOutsideObject(const btCollisionShape& shape, int part, const btVector3& point) {
+  const btCollisionShape* child = &shape;
+  btVector3 p = point;
+  if (shape.isCompound()) {
+    const auto& compound = static_cast<const btCompoundShape&>(shape);
+    if (part < 0 || part >= compound.getNumChildShapes()) return 0.0;
+    child = compound.getChildShape(part);
+    p = compound.getChildTransform(part).invXform(point);
+  }
+  if (!child->isConvex()) return 0.0;
+  const auto& convex = static_cast<const btConvexShape&>(*child);
+  double outside = 0.0;
+  const auto probe = [&](const btVector3& u) {
+    outside = std::max(outside, static_cast<double>(p.dot(u) -
+                                                    convex.localGetSupportingVertex(u).dot(u)));
+  };
+  if (p.length2() > 0) probe(p.normalized());
+  for (int axis = 0; axis < 3; ++axis) {
+    btVector3 u(0, 0, 0);
+    u[axis] = 1;
+    probe(u);
+    probe(-u);
+  }
+  return outside;
 }
 
 }  // namespace
@@ -131,6 +166,10 @@ GripperSim::~GripperSim() = default;
 
 int GripperSim::collisionPartCount() const {
   return std::max<int>(1, static_cast<int>(object_shapes_.size()) - 1);
+}
+
+double GripperSim::objectMinHalfSizeM() const {
+  return static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0;
 }
 
 double GripperSim::objectWidthM() const {
@@ -299,13 +338,44 @@ void GripperSim::forEachGelPoint(int gel_index, Visit visit) const {
   }
 }
 
+void GripperSim::dropContactsOffTheObject() {
+  // Bullet's GJK can hand back a witness point that is not on the object at all when a hull
+  // vertex first touches a gel face at distance ~0: a sphere's hull touched the gel with points
+  // 18.7 mm from the centre of a 10 mm ball, at the gel's corners. Such a point is never broken
+  // (neither body slides along the gel), so it stays in the manifold as a rigid lever arm on the
+  // object: a 0.26 degree tilt of the held ball made it 0.11 mm deeper than the real contact,
+  // the deepest point set the gel's force, and the ball sat 0.13 mm shallower than the physics
+  // reported (Bullet 2.88; 0.11 mm with 3.x). Points off the object are removed after each step;
+  // real ones lie on the shape, within its margin.
+  const btCollisionShape& shape = *object_shapes_.back();
+  btDispatcher& dispatcher = world_->dispatcher;
+  for (int i = 0; i < 2; ++i) {
+    const btCollisionObject* gel = world_->gels[i].get();
+    const btCollisionObject* object = world_->object.get();
+    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+      btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+      const bool gel_is_a = manifold->getBody0() == gel && manifold->getBody1() == object;
+      if (!gel_is_a && !(manifold->getBody1() == gel && manifold->getBody0() == object)) continue;
+      for (int c = manifold->getNumContacts() - 1; c >= 0; --c) {
+        const btManifoldPoint& point = manifold->getContactPoint(c);
+        const double outside =
+            gel_is_a ? distanceOutsideObject(shape, point.m_index1, point.m_localPointB)
+                     : distanceOutsideObject(shape, point.m_index0, point.m_localPointA);
+        if (outside > kOffObjectTolerance) manifold->removeContactPoint(c);
+      }
+    }
+  }
+}
+
 void GripperSim::updateGelStiffness() {
   // Secant stiffness of the law at the current penetration, shared among the contact points
   // in proportion to their depth: sum_i k d_i = F(d_max).
   const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
   for (int i = 0; i < 2; ++i) {
     double deepest = 0.0, sum = 0.0;
+    int points = 0;
     forEachGelPoint(i, [&](const btManifoldPoint& point, bool) {
+      ++points;
       const double d = -point.getDistance();
       if (d > 0.0) {
         deepest = std::max(deepest, d);
@@ -315,11 +385,24 @@ void GripperSim::updateGelStiffness() {
     const double k =
         sum > 0.0 ? config_.gel_law.force(deepest) / sum : config_.gel_law.secantStiffness(0.0);
     world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
+    // The gel touches over a patch, not a point: Coulomb friction over a disc of radius a
+    // under Hertzian pressure resists twisting up to (3 pi / 16) mu F a. Several contact points
+    // resist it through their lateral friction, but a single one has no such torque, so a ball
+    // touching each gel at one hull vertex would spin freely about the grip axis. A lone point
+    // gets the patch's torsional friction, a = sqrt(2 R d) the footprint of a ball of the
+    // object's smallest half-size R at its depth d. (Bullet applies torsional friction only
+    // with rolling friction on: a negligible one, 1 nm.)
+    const double patch_radius =
+        points == 1 ? std::sqrt(2.0 * objectMinHalfSizeM() * deepest) : 0.0;
+    const btScalar spinning = static_cast<btScalar>(3.0 * M_PI / 16.0 *
+                                                    config_.object.friction * patch_radius);
     // Points kept by a friction anchor are not re-created by collision detection: set them too.
     forEachGelPoint(i, [&](btManifoldPoint& point, bool) {
       point.m_combinedContactStiffness1 = k;
       point.m_combinedContactDamping1 = damping;
       point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+      point.m_combinedSpinningFriction = spinning;
+      point.m_combinedRollingFriction = spinning > 0 ? btScalar(1e-9) : btScalar(0);
     });
   }
 }
@@ -364,6 +447,7 @@ void GripperSim::step(int ticks) {
       moveFingers(dt);
       updateGelStiffness();
       world_->world.stepSimulation(dt, 0, dt);
+      dropContactsOffTheObject();
       measureContacts(dt);
     }
     ++ticks_;
