@@ -14,6 +14,17 @@ _NUMERIC = {
 }
 
 
+def _parse(kind, text):
+    """A label from its CSV text. Integers are read as integers: through a float, a 64-bit seed or
+    a nanosecond stamp (above 2**53) would lose its last digits."""
+    if kind is int:
+        try:
+            return int(text)
+        except ValueError:
+            return int(float(text))  # written as "3.0" or "1e3"
+    return kind(text)
+
+
 def _read_png(path):
     """H x W x C (or H x W) numpy array of a PNG, keeping its bit depth."""
     with Image.open(path) as image:
@@ -49,7 +60,7 @@ class ExportedDataset(torch.utils.data.Dataset):
         for row in rows:
             for key, kind in _NUMERIC.items():
                 if key in row and row[key] not in ("", "nan"):
-                    row[key] = kind(float(row[key])) if kind is int else kind(row[key])
+                    row[key] = _parse(kind, row[key])
         self.rows = [r for r in rows
                      if (materials is None or r["material"] in materials)
                      and (variants is None or r["variant"] in variants)

@@ -32,6 +32,28 @@ def _free_port():
 
 
 @unittest.skipIf(torch is None, TORCH_MISSING if torch is None else "")
+class LabelParsingTest(unittest.TestCase):
+    def test_64_bit_labels_keep_every_digit(self):
+        # A seed and a stamp above 2**53: read through a float they came back changed
+        # (7566867672928951314 -> ...296).
+        root = tempfile.mkdtemp(prefix="norm2tex_labels_test_")
+        try:
+            with open(os.path.join(root, "labels.csv"), "w") as f:
+                f.write("raw,diff,depth,material,variant,sensor,stamp,seed,beta\n")
+                f.write("a.png,b.png,,wood,3,digit_left,1795672061300976827,"
+                        "7566867672928951314,0.035\n")
+                f.write("a.png,b.png,,wood,3.0,digit_left,1e3,1,0.035\n")
+            rows = ExportedDataset(root, return_labels=True).rows
+            self.assertEqual(rows[0]["seed"], 7566867672928951314)
+            self.assertEqual(rows[0]["stamp"], 1795672061300976827)
+            self.assertEqual(rows[0]["variant"], 3)
+            self.assertAlmostEqual(rows[0]["beta"], 0.035)
+            self.assertEqual((rows[1]["variant"], rows[1]["stamp"]), (3, 1000))
+        finally:
+            shutil.rmtree(root, ignore_errors=True)
+
+
+@unittest.skipIf(torch is None, TORCH_MISSING if torch is None else "")
 class DatasetTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
