@@ -161,7 +161,8 @@ TEST(GripperSimTest, StoppingTheSolverAtConvergenceKeepsTheGrasp) {
   EXPECT_NEAR(exhaustive.contact(Finger::kLeft).normal_force_n,
               converged.contact(Finger::kLeft).normal_force_n,
               1e-4 * exhaustive.contact(Finger::kLeft).normal_force_n);
-  EXPECT_EQ(slipOpening(exhaustive), slipOpening(converged));
+  // (The grasp is measured on the object, so the two start a few nm apart.)
+  EXPECT_NEAR(slipOpening(exhaustive), slipOpening(converged), 1e-9);
 }
 
 TEST(GripperSimTest, SameSeedAndCommandsGiveIdenticalTrajectories) {

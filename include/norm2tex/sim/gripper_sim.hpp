@@ -4,11 +4,13 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/sim/gel_contact.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
 
 class btCollisionShape;
@@ -27,6 +29,9 @@ struct GelContactState {
   /// Deepest penetration of the object into the undeformed gel surface, metres (>= 0): the
   /// indentation the renderer draws at this pose.
   double penetration_m = 0.0;
+  /// The penetration is deeper than the gel law's table reaches (its last point, 2 mm by
+  /// default): the force is extrapolated, and past the gel's thickness it stops growing.
+  bool too_deep = false;
   /// Pose of the object frame in the gel frame (see SensorModel: +x image right, +y image
   /// down, +z out of the gel).
   Eigen::Isometry3d object_in_gel = Eigen::Isometry3d::Identity();
@@ -40,6 +45,17 @@ struct EpisodeStart {
   double grasp_opening = 0.0;    ///< normalised command the fingers closed to
 };
 
+/// How the object collides with the gels (GripperSim::collision()).
+struct ObjectCollision {
+  /// "box", "sphere", "capsule" (exact), "hull" (the convex hull of the mesh's vertices;
+  /// cylinders too, whose facets the renderer draws), or "decomposition".
+  std::string kind;
+  int parts = 1;  ///< convex parts (> 1 for a decomposition)
+  /// Deepest hollow of the mesh under its hull within the gel's reach (the gel law's deepest
+  /// point) of the sides facing the gels (world +-y), m; computed for "auto" collision only.
+  double hull_deviation_m = 0.0;
+};
+
 /// A Bullet simulation of a parallel gripper whose two DIGIT gels hold an object.
 ///
 /// World frame: z up, floor at z = 0. The gripper base sits at (0, 0, base_height) with the
@@ -48,12 +64,15 @@ struct EpisodeStart {
 /// its gel frame (the renderer's) is rotated so +z points at the other finger and +y (image
 /// down) points down the finger, towards the floor.
 ///
-/// Gel compliance: the gels are kinematic boxes with Bullet soft contacts (contact stiffness
-/// and damping, solved implicitly). Before every Bullet step each gel's contact stiffness is
-/// set to GelLaw::force(d) / sum(d_i) from the current penetrations d_i of its contact points
-/// (d = the deepest), so at rest the object sinks into each gel exactly as deep as the law
-/// says for the force it carries. Friction is the material's coefficient with friction anchors:
-/// a contact inside the Coulomb cone keeps its anchor, so a held object does not creep.
+/// Gel contact: the package computes where the object reaches into each gel pad itself (exact
+/// for a box, sphere or capsule and for a convex hull: see gelContactPoints) and hands Bullet
+/// at most four points per convex part and gel, kept between ticks as friction anchors: a
+/// contact inside the Coulomb cone keeps its anchor, so a held object does not creep. The gels
+/// are kinematic bodies with Bullet soft contacts (contact stiffness and damping, solved
+/// implicitly). Before every Bullet step each gel's contact stiffness is set to
+/// GelLaw::force(d) / sum(d_i) from the penetrations d_i of its points (d = the deepest, at
+/// most the gel's thickness), so at rest the object sinks into each gel exactly as deep as the
+/// law says for the force it carries.
 ///
 /// Fingers are position-controlled at max_speed, coupled (both at the same distance from the
 /// centre plane), and stop closing once either gel carries max_force: the grip force then comes
@@ -70,11 +89,16 @@ class GripperSim {
   GripperSim(const GripperSim&) = delete;
   GripperSim& operator=(const GripperSim&) = delete;
 
-  /// Re-seats the object between the open gels at `height_offset_m` (or, when absent, one drawn
-  /// uniformly from the configured range with `seed`), closes to the grasp opening without
-  /// gravity on the object, then lets it settle under gravity for episode.settle_s. Simulated
-  /// time keeps running through it. Throws Error (and changes nothing) for an offset outside
-  /// the scene's [episode.height_offset_low_m, height_offset_high_m] or NaN.
+  /// Re-seats the object between the fully open gels at `height_offset_m` (or, when absent, one
+  /// drawn uniformly from the configured range with `seed`), centred on its extent along the
+  /// grip axis so it touches neither gel, and grasps it without gravity on it: the fingers
+  /// close until both gels touch, then to the grip that indents each by
+  /// episode.grasp_indentation_m (or carries episode.grasp_force_n), measured on the object's
+  /// real surface; with episode.grasp_opening >= 0 they close to that opening instead. Then
+  /// the object settles under gravity for episode.settle_s. Simulated time keeps running
+  /// through it. Throws Error (and changes nothing) for an offset outside the scene's
+  /// [episode.height_offset_low_m, height_offset_high_m] or NaN; throws Error naming the offset
+  /// when the object's sides miss the gel pads there (the fingers are then left open).
   EpisodeStart reset(std::uint64_t seed, std::optional<double> height_offset_m = std::nullopt);
 
   /// Normalised opening command, 0 = closed (gap min_gap) ... 1 = open (gap max_gap). Throws
@@ -116,20 +140,27 @@ class GripperSim {
   const GripperSimConfig& config() const { return config_; }
   const ObjectMesh& object() const { return object_; }
   /// Convex pieces the object collides as: 1 for a box or a hull, more for a decomposition.
-  int collisionPartCount() const;
+  int collisionPartCount() const { return collision_.parts; }
+  const ObjectCollision& collision() const { return collision_; }
 
  private:
   struct World;  // the Bullet objects
 
+  /// Chooses the object's collision (see ObjectOptions::collision) about the body origin.
+  void makeCollision(const Eigen::Vector3d& centre);
   void buildWorld(double object_height_m);
   void moveFingers(double dt);
-  /// Calls visit(btManifoldPoint&, bool gel_is_body_a) for every contact point between gel
-  /// `gel_index` and the object.
+  /// Calls visit(btManifoldPoint&) for every contact point between gel `gel_index` and the
+  /// object (the gel is the manifold's body 0).
   template <typename Visit>
   void forEachGelPoint(int gel_index, Visit visit) const;
-  void dropContactsOffTheObject();
+  /// Where the object reaches into gel `gel_index` now, per contact part.
+  std::vector<std::vector<GelContactPoint>> gelPoints(int gel_index) const;
+  void updateGelContacts();
   void updateGelStiffness();
   void measureContacts(double dt);
+  /// Closes from the open seat until both gels touch, then to the configured grip.
+  double closeOnTheObject(double offset_m);
   double objectWidthM() const;
   double objectMinHalfSizeM() const;
 
@@ -137,8 +168,13 @@ class GripperSim {
   ObjectMesh object_;
   /// Object frame in the collision body's frame (the body sits at the bounds' centre).
   Eigen::Isometry3d object_in_body_ = Eigen::Isometry3d::Identity();
-  /// The object's collision shape is back(); any shapes before it are its convex parts.
+  /// The object's Bullet shape (for the floor and its inertia) is back(); any shapes before it
+  /// are its convex parts.
   std::vector<std::unique_ptr<btCollisionShape>> object_shapes_;
+  /// What the gels touch, in the body frame: convex parts, or one capsule (a sphere: a == b).
+  std::vector<ConvexPolytope> contact_parts_;
+  std::optional<Capsule> contact_capsule_;
+  ObjectCollision collision_;
   std::unique_ptr<World> world_;
   std::array<GelContactState, 2> contacts_;
   double command_ = 1.0;

@@ -27,10 +27,11 @@ struct ObjectOptions {
   std::string mesh = "box:30x30x30";
   double scale = 1.0;     ///< mesh file units to metres (0.001 for millimetres)
   double mass_kg = 0.10;  ///< the paper's cube: ~30 mm of PLA, 100 g with its insert
-  /// "auto" (an exact box if the mesh is one, else the convex hull of its vertices), "box"
-  /// (its bounding box), "hull", or "decomposition" (opt-in for concave objects: HACD convex
-  /// parts, computed once at construction; against a flat gel a concave object touches only
-  /// its hull until the gel reaches into a hollow, so "hull" is exact for most grasps).
+  /// "auto": an exact box, sphere or capsule when the mesh is one (loadObjectMesh), else the
+  /// convex hull of its vertices, or a convex decomposition when the hull bridges a hollow
+  /// deeper than 0.15 mm on a side facing the gels (see GripperSim::collision()). "box" (the
+  /// bounding box), "hull" and "decomposition" (HACD convex parts, computed once at
+  /// construction) force one.
   std::string collision = "auto";
   double friction = 0.5;  ///< Coulomb coefficient against the gel (from the material config)
   std::string material = "wood";  ///< label only: the material the friction came from
@@ -55,10 +56,12 @@ struct EpisodeOptions {
   /// 0-2.5 cm).
   double height_offset_low_m = 0.0;
   double height_offset_high_m = 0.025;
-  /// Opening the fingers close to before control is handed over; a value < 0 means: the
-  /// opening that indents each gel by `grasp_indentation_m` for the object's width.
+  /// Opening the fingers close to before control is handed over (the scene's fixed grasp); a
+  /// value < 0 means: close until both gels touch the object, then on until each gel is
+  /// indented `grasp_indentation_m` (or carries `grasp_force_n` when that is > 0).
   double grasp_opening = -1.0;
   double grasp_indentation_m = 1.0e-3;
+  double grasp_force_n = 0.0;
   double settle_s = 0.5;  ///< simulated seconds under gravity before control is handed over
 };
 

@@ -19,13 +19,20 @@ namespace {
 // indentations we resolve (box margins sit inside the box, so boxes stay exact).
 constexpr double kBoxMargin = 2e-4;
 constexpr double kHullMargin = 2e-5;
-// The fingers open this far beyond the object before an episode closes them.
+// The open gripper must clear the object by this much on each side.
 constexpr double kSeatClearance = 1e-3;
 // After the fingers reach the grasp command, the contact settles this long before gravity.
 constexpr double kGraspHoldS = 0.1;
-// A gel contact point whose object-side point lies farther than this outside the object's
-// collision shape is not a contact (see dropContactsOffTheObject).
-constexpr double kOffObjectTolerance = 5e-5;
+// A gel contact point that slides this far along the gel, or separates this far, is dropped
+// (Bullet's contact breaking threshold for the package's own manifolds).
+constexpr double kContactBreakingM = 3e-4;
+// "auto" collision decomposes a mesh whose hull bridges a hollow deeper than this on a side
+// facing the gels: the tolerance the physics keeps to the rendered indentation.
+constexpr double kMaxHullDeviationM = 0.15e-3;
+// Collision filter groups: the gels never collide through Bullet (the package makes their
+// contacts), the object still meets the floor.
+constexpr int kGelGroup = 1 << 6;
+constexpr int kObjectGroup = 1 << 7;
 
 btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
 Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
@@ -61,8 +68,13 @@ struct GripperSim::World {
   std::unique_ptr<btRigidBody> floor;
   std::array<std::unique_ptr<btRigidBody>, 2> gels;
   std::unique_ptr<btRigidBody> object;
+  /// Per gel, one manifold per convex part of the object (body 0 the gel, body 1 the object).
+  std::array<std::vector<btPersistentManifold*>, 2> manifolds;
 
   ~World() {
+    for (auto& gel_manifolds : manifolds) {
+      for (btPersistentManifold* manifold : gel_manifolds) dispatcher.releaseManifold(manifold);
+    }
     if (object) world.removeRigidBody(object.get());
     for (auto& gel : gels) {
       if (gel) world.removeRigidBody(gel.get());
@@ -73,30 +85,18 @@ struct GripperSim::World {
 
 namespace {
 
-// The object's collision shape is the last element; any before it are its parts.
-std::vector<std::unique_ptr<btCollisionShape>> makeObjectShapes(const ObjectMesh& object,
-                                                                const std::string& collision,
-                                                                const Eigen::Vector3d& centre) {
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  const Eigen::Vector3d half = object.mesh.bounds().sizes().cast<double>() / 2.0;
-  if (collision == "box" || (collision == "auto" && object.shape == ObjectMesh::Shape::kBox)) {
-    auto box = std::make_unique<btBoxShape>(toBt(half));
-    box->setMargin(std::min(kBoxMargin, 0.25 * half.minCoeff()));
-    shapes.push_back(std::move(box));
-    return shapes;
-  }
-  if (collision == "decomposition") return decomposeConvex(object.mesh, centre, kHullMargin);
-  // Spheres take their mesh's hull too (within 5 um of the sphere at 96 x 192): Bullet's
-  // sphere-box contact is a single point that did not hold a pinched ball (it slid 7 mm
-  // under its own weight at 2.6 N of grip), while the polyhedral hull holds it still. (The
-  // hull too touches each gel at one vertex; the gel's torsional friction keeps it from
-  // spinning, see updateGelStiffness.)
-  // Convex hull of the render mesh's vertices about the body origin, reduced by btShapeHull
-  // so contact generation stays cheap for big meshes.
+std::vector<Eigen::Vector3d> verticesAbout(const TexturedMesh& mesh, const Eigen::Vector3d& centre) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(mesh.vertices().size());
+  for (const Eigen::Vector3f& v : mesh.vertices()) points.push_back(v.cast<double>() - centre);
+  return points;
+}
+
+// Bullet's shape of a convex polytope, for the floor and the inertia (the gels use the polytope
+// itself). btShapeHull keeps big meshes cheap against the floor.
+std::unique_ptr<btCollisionShape> bulletHull(const std::vector<Eigen::Vector3d>& points) {
   btConvexHullShape full;
-  for (const Eigen::Vector3f& v : object.mesh.vertices()) {
-    full.addPoint(toBt(v.cast<double>() - centre), false);
-  }
+  for (const Eigen::Vector3d& p : points) full.addPoint(toBt(p), false);
   full.recalcLocalAabb();
   full.setMargin(0.0);
   btShapeHull reducer(&full);
@@ -107,38 +107,20 @@ std::vector<std::unique_ptr<btCollisionShape>> makeObjectShapes(const ObjectMesh
   }
   hull->recalcLocalAabb();
   hull->setMargin(kHullMargin);
-  shapes.push_back(std::move(hull));
-  return shapes;
+  return hull;
 }
 
-// How far (m) a point in the object's body frame lies outside its collision shape, at least:
-// the largest p.u - h(u) over the point's own direction and the six axes, h the shape's
-// support function (margin included). Never positive for a point on or in the shape; part is
-// the compound child the point is on.
-double distanceOutsideObject(const btCollisionShape& shape, int part, const btVector3& point) {
-  const btCollisionShape* child = &shape;
-  btVector3 p = point;
-  if (shape.isCompound()) {
-    const auto& compound = static_cast<const btCompoundShape&>(shape);
-    if (part < 0 || part >= compound.getNumChildShapes()) return 0.0;
-    child = compound.getChildShape(part);
-    p = compound.getChildTransform(part).invXform(point);
+std::unique_ptr<btCollisionShape> roundShape(const ObjectMesh& object) {
+  const double r = object.radius_m, h = object.half_length_m;
+  std::unique_ptr<btCollisionShape> shape;
+  if (object.shape == ObjectMesh::Shape::kSphere) {
+    shape = std::make_unique<btSphereShape>(r);
+  } else if (object.shape == ObjectMesh::Shape::kCapsule) {
+    if (object.axis == 0) shape = std::make_unique<btCapsuleShapeX>(r, 2 * h);
+    if (object.axis == 1) shape = std::make_unique<btCapsuleShape>(r, 2 * h);
+    if (object.axis == 2) shape = std::make_unique<btCapsuleShapeZ>(r, 2 * h);
   }
-  if (!child->isConvex()) return 0.0;
-  const auto& convex = static_cast<const btConvexShape&>(*child);
-  double outside = 0.0;
-  const auto probe = [&](const btVector3& u) {
-    outside = std::max(outside, static_cast<double>(p.dot(u) -
-                                                    convex.localGetSupportingVertex(u).dot(u)));
-  };
-  if (p.length2() > 0) probe(p.normalized());
-  for (int axis = 0; axis < 3; ++axis) {
-    btVector3 u(0, 0, 0);
-    u[axis] = 1;
-    probe(u);
-    probe(-u);
-  }
-  return outside;
+  return shape;
 }
 
 }  // namespace
@@ -148,8 +130,6 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   object_ = loadObjectMesh(config_.object.mesh, config_.object.scale);
   const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
   object_in_body_ = Eigen::Translation3d(-centre);
-  // Built once: resets rebuild the world but reuse the (stateless) shape.
-  object_shapes_ = makeObjectShapes(object_, config_.object.collision, centre);
   if (objectWidthM() + 2 * kSeatClearance > config_.gripper.max_gap_m) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
@@ -157,6 +137,19 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
             << config_.gripper.max_gap_m * 1e3 << " minus 2 mm of clearance";
     throw Error(message.str());
   }
+  const EpisodeOptions& e = config_.episode;
+  const double grip_depth =
+      e.grasp_force_n > 0 ? config_.gel_law.indentation(e.grasp_force_n) : e.grasp_indentation_m;
+  if (e.grasp_opening < 0 && objectWidthM() - 2 * grip_depth < config_.gripper.min_gap_m) {
+    std::ostringstream message;
+    message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
+            << " mm wide along the grip axis: the closed gripper (gripper.min_gap_mm = "
+            << config_.gripper.min_gap_m * 1e3 << ") cannot indent both gels "
+            << grip_depth * 1e3 << " mm into it";
+    throw Error(message.str());
+  }
+  // Built once: resets rebuild the world but reuse the (stateless) shapes.
+  makeCollision(centre);
   command_ = 1.0;
   finger_position_m_ = config_.gripper.max_gap_m / 2.0;
   buildWorld(config_.episode.height_offset_low_m);
@@ -164,8 +157,69 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
 
 GripperSim::~GripperSim() = default;
 
-int GripperSim::collisionPartCount() const {
-  return std::max<int>(1, static_cast<int>(object_shapes_.size()) - 1);
+void GripperSim::makeCollision(const Eigen::Vector3d& centre) {
+  const std::string& mode = config_.object.collision;
+  const ObjectMesh& o = object_;
+  if (mode == "box" || (mode == "auto" && o.shape == ObjectMesh::Shape::kBox)) {
+    const Eigen::Vector3d half = o.mesh.bounds().sizes().cast<double>() / 2.0;
+    auto box = std::make_unique<btBoxShape>(toBt(half));
+    box->setMargin(std::min(kBoxMargin, 0.25 * half.minCoeff()));
+    object_shapes_.push_back(std::move(box));
+    std::vector<Eigen::Vector3d> corners;
+    for (int k = 0; k < 8; ++k) {
+      corners.push_back(half.cwiseProduct(
+          Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
+    }
+    contact_parts_.push_back(ConvexPolytope::hullOf(corners));
+    collision_.kind = "box";
+    return;
+  }
+  if (mode == "auto" &&
+      (o.shape == ObjectMesh::Shape::kSphere || o.shape == ObjectMesh::Shape::kCapsule)) {
+    object_shapes_.push_back(roundShape(o));
+    Capsule capsule;
+    capsule.radius = o.radius_m;
+    if (o.shape == ObjectMesh::Shape::kCapsule) {
+      capsule.b[o.axis] = o.half_length_m;
+      capsule.a[o.axis] = -o.half_length_m;
+    }
+    contact_capsule_ = capsule;
+    collision_.kind = shapeName(o.shape);
+    return;
+  }
+  const std::vector<Eigen::Vector3d> points = verticesAbout(o.mesh, centre);
+  ConvexPolytope hull = ConvexPolytope::hullOf(points);
+  // A flat gel meets a concave mesh where its hull does, to the same depth (the deepest point of
+  // a body in a half-space is a hull vertex); only where the hull bridges a hollow within the
+  // gel's reach (the law's deepest point) on the sides facing the gels (world +-y: the object
+  // starts unrotated) does the contact's footprint differ from the mesh's.
+  if (mode == "auto") {
+    collision_.hull_deviation_m = hullDeviation(hull, points, Eigen::Vector3d::UnitY(),
+                                                config_.gel_law.points().back().first);
+  }
+  if (mode == "decomposition" ||
+      (mode == "auto" && collision_.hull_deviation_m > kMaxHullDeviationM)) {
+    object_shapes_ = decomposeConvex(o.mesh, centre, kHullMargin);
+    for (size_t i = 0; i + 1 < object_shapes_.size(); ++i) {
+      const auto& part = static_cast<const btConvexHullShape&>(*object_shapes_[i]);
+      std::vector<Eigen::Vector3d> part_points;
+      for (int k = 0; k < part.getNumPoints(); ++k) {
+        part_points.push_back(toEigen(part.getUnscaledPoints()[k]));
+      }
+      try {
+        contact_parts_.push_back(ConvexPolytope::hullOf(part_points));
+      } catch (const Error&) {
+        // A flat sliver (HACD can return one): nothing a gel could press into.
+      }
+    }
+    if (contact_parts_.empty()) throw Error("convex decomposition of the object mesh produced no solid part");
+    collision_.kind = "decomposition";
+    collision_.parts = static_cast<int>(contact_parts_.size());
+    return;
+  }
+  object_shapes_.push_back(bulletHull(points));
+  contact_parts_.push_back(std::move(hull));
+  collision_.kind = "hull";
 }
 
 double GripperSim::objectMinHalfSizeM() const {
@@ -259,7 +313,8 @@ void GripperSim::buildWorld(double object_height_m) {
   world_->floor = std::make_unique<btRigidBody>(
       btRigidBody::btRigidBodyConstructionInfo(0, nullptr, world_->floor_shape.get()));
   world_->floor->setFriction(0.5);
-  w.addRigidBody(world_->floor.get());
+  w.addRigidBody(world_->floor.get(), btBroadphaseProxy::StaticFilter,
+                 btBroadphaseProxy::AllFilter & ~kGelGroup);
 
   // Gels: kinematic boxes behind the gel surface, soft-contact, with the material's friction
   // (Bullet multiplies the two bodies' coefficients; the object's is 1).
@@ -277,7 +332,7 @@ void GripperSim::buildWorld(double object_height_m) {
                            btCollisionObject::CF_HAS_FRICTION_ANCHOR);
     gel->setActivationState(DISABLE_DEACTIVATION);
     gel->setContactStiffnessAndDamping(config_.gel_law.secantStiffness(0.0), p.gel_damping);
-    w.addRigidBody(gel.get());
+    w.addRigidBody(gel.get(), kGelGroup, 0);
     world_->gels[i] = std::move(gel);
   }
 
@@ -295,7 +350,17 @@ void GripperSim::buildWorld(double object_height_m) {
   Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
   body.translation() = Eigen::Vector3d(0, 0, config_.gripper.base_height_m + object_height_m);
   world_->object->setWorldTransform(toBt(body));
-  w.addRigidBody(world_->object.get());
+  w.addRigidBody(world_->object.get(), kObjectGroup, btBroadphaseProxy::StaticFilter);
+  // The gel contacts live in the package's own manifolds, which the solver takes like any other.
+  const size_t parts = contact_capsule_ ? 1 : contact_parts_.size();
+  for (int i = 0; i < 2; ++i) {
+    for (size_t k = 0; k < parts; ++k) {
+      btPersistentManifold* manifold =
+          world_->dispatcher.getNewManifold(world_->gels[i].get(), world_->object.get());
+      manifold->setContactBreakingThreshold(kContactBreakingM);
+      world_->manifolds[i].push_back(manifold);
+    }
+  }
 
   moveFingers(0.0);
   contacts_ = {};
@@ -325,43 +390,70 @@ void GripperSim::moveFingers(double dt) {
 
 template <typename Visit>
 void GripperSim::forEachGelPoint(int gel_index, Visit visit) const {
-  btDispatcher& dispatcher = world_->dispatcher;
-  const btCollisionObject* gel = world_->gels[gel_index].get();
-  const btCollisionObject* object = world_->object.get();
-  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
-    btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
-    const bool gel_is_a = manifold->getBody0() == gel && manifold->getBody1() == object;
-    if (!gel_is_a && !(manifold->getBody1() == gel && manifold->getBody0() == object)) continue;
-    for (int c = 0; c < manifold->getNumContacts(); ++c) {
-      visit(manifold->getContactPoint(c), gel_is_a);
-    }
+  for (btPersistentManifold* manifold : world_->manifolds[gel_index]) {
+    for (int c = 0; c < manifold->getNumContacts(); ++c) visit(manifold->getContactPoint(c));
   }
 }
 
-void GripperSim::dropContactsOffTheObject() {
-  // Bullet's GJK can hand back a witness point that is not on the object at all when a hull
-  // vertex first touches a gel face at distance ~0: a sphere's hull touched the gel with points
-  // 18.7 mm from the centre of a 10 mm ball, at the gel's corners. Such a point is never broken
-  // (neither body slides along the gel), so it stays in the manifold as a rigid lever arm on the
-  // object: a 0.26 degree tilt of the held ball made it 0.11 mm deeper than the real contact,
-  // the deepest point set the gel's force, and the ball sat 0.13 mm shallower than the physics
-  // reported (Bullet 2.88; 0.11 mm with 3.x). Points off the object are removed after each step;
-  // real ones lie on the shape, within its margin.
-  const btCollisionShape& shape = *object_shapes_.back();
-  btDispatcher& dispatcher = world_->dispatcher;
+std::vector<std::vector<GelContactPoint>> GripperSim::gelPoints(int gel_index) const {
+  const GelPad pad{config_.gel_width_m / 2, config_.gel_height_m / 2};
+  const Eigen::Isometry3d body_in_gel =
+      gelInWorld(static_cast<Finger>(gel_index)).inverse() *
+      toEigen(world_->object->getWorldTransform());
+  std::vector<std::vector<GelContactPoint>> points;
+  if (contact_capsule_) {
+    points.push_back(gelContactPoints(*contact_capsule_, body_in_gel, pad));
+  } else {
+    for (const ConvexPolytope& part : contact_parts_) {
+      points.push_back(gelContactPoints(part, body_in_gel, pad));
+    }
+  }
+  return points;
+}
+
+void GripperSim::updateGelContacts() {
+  // The object's points inside each gel pad, at most four per part, join the manifold as Bullet
+  // adds its own: a new point near a kept one replaces it, unless the kept one is an anchor
+  // inside its friction cone (btPersistentManifold::replaceContactPoint); kept points are
+  // first moved with their bodies and dropped once they separate, slide or leave the pad.
+  const btRigidBody& object = *world_->object;
+  const double half_w = config_.gel_width_m / 2, half_h = config_.gel_height_m / 2;
   for (int i = 0; i < 2; ++i) {
-    const btCollisionObject* gel = world_->gels[i].get();
-    const btCollisionObject* object = world_->object.get();
-    for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
-      btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
-      const bool gel_is_a = manifold->getBody0() == gel && manifold->getBody1() == object;
-      if (!gel_is_a && !(manifold->getBody1() == gel && manifold->getBody0() == object)) continue;
-      for (int c = manifold->getNumContacts() - 1; c >= 0; --c) {
-        const btManifoldPoint& point = manifold->getContactPoint(c);
-        const double outside =
-            gel_is_a ? distanceOutsideObject(shape, point.m_index1, point.m_localPointB)
-                     : distanceOutsideObject(shape, point.m_index0, point.m_localPointA);
-        if (outside > kOffObjectTolerance) manifold->removeContactPoint(c);
+    const btRigidBody& gel = *world_->gels[i];
+    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
+    const Eigen::Vector3d normal_on_object = -gel_in_world.linear().col(2);  // into the gel
+    const std::vector<std::vector<GelContactPoint>> parts = gelPoints(i);
+    for (size_t k = 0; k < parts.size(); ++k) {
+      btPersistentManifold& manifold = *world_->manifolds[i][k];
+      manifold.refreshContactPoints(gel.getWorldTransform(), object.getWorldTransform());
+      for (int c = manifold.getNumContacts() - 1; c >= 0; --c) {
+        const Eigen::Vector3d on_object =
+            gel_in_world.inverse() * toEigen(manifold.getContactPoint(c).m_positionWorldOnB);
+        // (Points the pad's edge clipped lie on it: a kept anchor there may move past it by
+        // as much as it may slide, or every held object would lose its anchors there.)
+        if (std::abs(on_object.x()) > half_w + kContactBreakingM ||
+            std::abs(on_object.y()) > half_h + kContactBreakingM) {
+          manifold.removeContactPoint(c);
+        }
+      }
+      for (const GelContactPoint& p : spanningContactPoints(parts[k])) {
+        const Eigen::Vector3d on_object = gel_in_world * p.position;
+        const Eigen::Vector3d on_gel =
+            gel_in_world * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
+        btManifoldPoint point(gel.getWorldTransform().invXform(toBt(on_gel)),
+                              object.getWorldTransform().invXform(toBt(on_object)),
+                              toBt(normal_on_object), static_cast<btScalar>(-p.depth));
+        point.m_positionWorldOnA = toBt(on_gel);
+        point.m_positionWorldOnB = toBt(on_object);
+        point.m_combinedFriction = static_cast<btScalar>(config_.object.friction);
+        point.m_combinedRestitution = 0;
+        point.m_contactPointFlags |= BT_CONTACT_FLAG_FRICTION_ANCHOR;
+        const int index = manifold.getCacheEntry(point);
+        if (index >= 0) {
+          manifold.replaceContactPoint(point, index);
+        } else {
+          manifold.addManifoldPoint(point);
+        }
       }
     }
   }
@@ -374,7 +466,7 @@ void GripperSim::updateGelStiffness() {
   for (int i = 0; i < 2; ++i) {
     double deepest = 0.0, sum = 0.0;
     int points = 0;
-    forEachGelPoint(i, [&](const btManifoldPoint& point, bool) {
+    forEachGelPoint(i, [&](const btManifoldPoint& point) {
       ++points;
       const double d = -point.getDistance();
       if (d > 0.0) {
@@ -382,8 +474,11 @@ void GripperSim::updateGelStiffness() {
         sum += d;
       }
     });
-    const double k =
-        sum > 0.0 ? config_.gel_law.force(deepest) / sum : config_.gel_law.secantStiffness(0.0);
+    // Deeper than the gel is thick the object would press on the sensor's body: the force
+    // stops growing there, so no mistake can expel the object at absurd speed.
+    const double k = sum > 0.0
+                         ? config_.gel_law.force(std::min(deepest, config_.gel_thickness_m)) / sum
+                         : config_.gel_law.secantStiffness(0.0);
     world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
     // The gel touches over a patch, not a point: Coulomb friction over a disc of radius a
     // under Hertzian pressure resists twisting up to (3 pi / 16) mu F a. Several contact points
@@ -397,7 +492,7 @@ void GripperSim::updateGelStiffness() {
     const btScalar spinning = static_cast<btScalar>(3.0 * M_PI / 16.0 *
                                                     config_.object.friction * patch_radius);
     // Points kept by a friction anchor are not re-created by collision detection: set them too.
-    forEachGelPoint(i, [&](btManifoldPoint& point, bool) {
+    forEachGelPoint(i, [&](btManifoldPoint& point) {
       point.m_combinedContactStiffness1 = k;
       point.m_combinedContactDamping1 = damping;
       point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
@@ -409,23 +504,24 @@ void GripperSim::updateGelStiffness() {
 
 void GripperSim::measureContacts(double dt) {
   const Eigen::Isometry3d object_in_world = objectInWorld();
+  const double deepest_law_point = config_.gel_law.points().back().first;
   for (int i = 0; i < 2; ++i) {
     const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
     GelContactState& state = contacts_[i];
     state = GelContactState{};
     state.object_in_gel = gel_in_world.inverse() * object_in_world;
+    // The indentation at the pose the step ended in: what the renderer draws.
+    for (const std::vector<GelContactPoint>& part : gelPoints(i)) {
+      for (const GelContactPoint& p : part) state.penetration_m = std::max(state.penetration_m, p.depth);
+    }
+    state.too_deep = state.penetration_m > deepest_law_point;
     Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
-    forEachGelPoint(i, [&](const btManifoldPoint& point, bool gel_is_a) {
-      state.penetration_m =
-          std::max(state.penetration_m, -static_cast<double>(point.getDistance()));
+    forEachGelPoint(i, [&](const btManifoldPoint& point) {
       state.normal_force_n += point.getAppliedImpulse() / dt;
-      // Friction impulses act on body A along the lateral directions; the gel feels the
-      // object's reaction.
-      const Eigen::Vector3d on_a =
-          (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
-           toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
-          dt;
-      shear_world += gel_is_a ? on_a : Eigen::Vector3d(-on_a);
+      // Friction impulses act on body A (the gel) along the lateral directions.
+      shear_world += (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
+                      toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
+                     dt;
     });
     state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
     state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
@@ -445,13 +541,56 @@ void GripperSim::step(int ticks) {
   for (int t = 0; t < ticks; ++t) {
     for (int s = 0; s < substeps; ++s) {
       moveFingers(dt);
+      updateGelContacts();
       updateGelStiffness();
       world_->world.stepSimulation(dt, 0, dt);
-      dropContactsOffTheObject();
       measureContacts(dt);
     }
     ++ticks_;
   }
+}
+
+double GripperSim::closeOnTheObject(double offset_m) {
+  const EpisodeOptions& e = config_.episode;
+  const GripperOptions& g = config_.gripper;
+  const auto openingForGap = [&](double gap) {
+    return std::clamp((gap - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0, 1.0);
+  };
+  const auto ticksToArrive = [&] {
+    const double travel = std::abs(finger_position_m_ - gapForOpening(command_) / 2.0);
+    return static_cast<int>(std::ceil(travel / g.max_speed_m_s / tickSeconds()));
+  };
+  if (e.grasp_opening >= 0.0) {
+    command_ = e.grasp_opening;
+    step(ticksToArrive());
+    return command_;
+  }
+  // Close until both gels touch. An object that has not touched both by the time the gap is
+  // narrower than its width minus the gel law's deepest point on each side never will: its
+  // sides miss the pads at this height.
+  const double deepest_law_point = config_.gel_law.points().back().first;
+  command_ = openingForGap(objectWidthM() - 2 * deepest_law_point);
+  const int limit = ticksToArrive() + 1;
+  for (int t = 0; !(contacts_[0].in_contact && contacts_[1].in_contact); ++t) {
+    if (t > limit) {
+      std::ostringstream message;
+      message << "the object does not reach both gel pads at height offset " << offset_m * 1e3
+              << " mm: its sides miss the " << config_.gel_width_m * 1e3 << " x "
+              << config_.gel_height_m * 1e3
+              << " mm pads there (choose a smaller episode.height_offset_mm)";
+      throw Error(message.str());
+    }
+    step(1);
+  }
+  // Then on to the grip, measured on the object's surface: its width between the gels is the gap
+  // plus what each gel is already indented.
+  const double depth =
+      e.grasp_force_n > 0.0 ? config_.gel_law.indentation(e.grasp_force_n) : e.grasp_indentation_m;
+  const double width = 2.0 * finger_position_m_ + contacts_[0].penetration_m +
+                       contacts_[1].penetration_m;
+  command_ = openingForGap(width - 2.0 * depth);
+  step(ticksToArrive());
+  return command_;
 }
 
 EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_offset_m) {
@@ -471,33 +610,38 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
     throw Error(message.str());
   }
   EpisodeStart start;
-  start.episode = ++episode_;
   start.seed = seed;
   start.height_offset_m = offset;
   const GripperOptions& g = config_.gripper;
-  start.grasp_opening =
-      e.grasp_opening >= 0.0
-          ? e.grasp_opening
-          : std::clamp((objectWidthM() - 2.0 * e.grasp_indentation_m - g.min_gap_m) /
-                           (g.max_gap_m - g.min_gap_m),
-                       0.0, 1.0);
 
-  // Seat the object between gels opened just wider than it, without gravity on it.
+  // Seat the object, centred on its extent along the grip axis, between gels opened
+  // kSeatClearance wider than it on each side, without gravity on it.
   dropped_ = false;
-  command_ = std::clamp(
-      (objectWidthM() + 2 * kSeatClearance - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0, 1.0);
-  finger_position_m_ = gapForOpening(command_) / 2.0;
-  buildWorld(offset);
+  const auto seat = [&] {
+    command_ = std::clamp(
+        (objectWidthM() + 2 * kSeatClearance - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0,
+        1.0);
+    finger_position_m_ = gapForOpening(command_) / 2.0;
+    buildWorld(offset);
+  };
+  seat();
+  for (int i = 0; i < 2; ++i) {
+    for (const auto& part : gelPoints(i)) {
+      if (!part.empty()) throw Error("the seated object overlaps a gel (a bug: please report it)");
+    }
+  }
   world_->object->setGravity(btVector3(0, 0, 0));
-
-  // Close to the grasp command; then hold, still weightless, until the contacts settle.
-  command_ = start.grasp_opening;
-  const double travel = std::abs(finger_position_m_ - gapForOpening(command_) / 2.0);
-  const int close_ticks = static_cast<int>(std::ceil(travel / g.max_speed_m_s / tickSeconds()));
-  step(close_ticks + static_cast<int>(std::ceil(kGraspHoldS / tickSeconds())));
-
+  try {
+    start.grasp_opening = closeOnTheObject(offset);
+  } catch (const Error&) {
+    seat();  // open again, the object at rest between the gels
+    throw;
+  }
+  // Hold, still weightless, until the contacts settle; then gravity.
+  step(static_cast<int>(std::ceil(kGraspHoldS / tickSeconds())));
   world_->object->setGravity(world_->world.getGravity());
   step(static_cast<int>(std::ceil(e.settle_s / tickSeconds())));
+  start.episode = ++episode_;
   return start;
 }
 

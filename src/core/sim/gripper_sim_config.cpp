@@ -96,9 +96,12 @@ void validate(const GripperSimConfig& c) {
                    "[low, high] with low <= high, each within +-500 mm");
   requireParameter(e.grasp_opening < 0.0 || e.grasp_opening <= 1.0, "episode.grasp_opening",
                    e.grasp_opening, "[0, 1], or < 0 to derive it from grasp_indentation_mm");
-  requireParameter(e.grasp_indentation_m >= 0.0 && e.grasp_indentation_m < c.gel_thickness_m,
+  requireParameter(e.grasp_indentation_m > 0.0 && e.grasp_indentation_m < c.gel_thickness_m,
                    "episode.grasp_indentation_mm", e.grasp_indentation_m * 1e3,
-                   "[0, gel thickness)");
+                   "(0, gel thickness)");
+  requireParameter(e.grasp_force_n >= 0.0 && e.grasp_force_n < g.max_force_n,
+                   "episode.grasp_force_n", e.grasp_force_n,
+                   "[0, gripper.max_force_n) N (0: grasp_indentation_mm decides)");
   requireParameter(e.settle_s >= 0.0 && e.settle_s <= 60.0, "episode.settle_s", e.settle_s,
                    "[0, 60] s");
   requireParameter(c.gel_width_m > 0.001 && c.gel_width_m <= 0.2, "gel_width_m", c.gel_width_m,
@@ -157,7 +160,8 @@ GripperSimConfig loadGripperSimConfig(const std::string& yaml_path) {
 
     const YAML::Node e = root["episode"];
     requireKnownKeys(e, "episode",
-                     {"height_offset_mm", "grasp_opening", "grasp_indentation_mm", "settle_s"});
+                     {"height_offset_mm", "grasp_opening", "grasp_indentation_mm", "grasp_force_n",
+                      "settle_s"});
     if (e && e["height_offset_mm"]) {
       const auto range = e["height_offset_mm"].as<std::vector<double>>();
       if (range.size() != 2) throw Error("episode.height_offset_mm needs [low, high]");
@@ -166,6 +170,7 @@ GripperSimConfig loadGripperSimConfig(const std::string& yaml_path) {
     }
     read(e, "grasp_opening", c.episode.grasp_opening);
     readMm(e, "grasp_indentation_mm", c.episode.grasp_indentation_m);
+    read(e, "grasp_force_n", c.episode.grasp_force_n);
     read(e, "settle_s", c.episode.settle_s);
 
     const YAML::Node gel = root["gel"];
