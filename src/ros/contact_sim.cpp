@@ -165,6 +165,11 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
       params_.synchronous ? "synchronous" : "real-time", params_.scene.c_str(),
       params_.material.c_str(), friction, config.physics.rate_hz, ticks_per_frame_,
       params_.frame_rate, config.object.name.c_str(), config.object.mesh.c_str());
+  const ObjectCollision& collision = sim_->collision();
+  ROS_INFO("contact_sim: the object collides as %s (%d part%s; its hull bridges hollows %.2f mm "
+           "deep where the gels reach)",
+           collision.kind.c_str(), collision.parts, collision.parts == 1 ? "" : "s",
+           collision.hull_deviation_m * 1e3);
 }
 
 ros::Time ContactSim::frameStamp() const {
@@ -413,6 +418,13 @@ std::uint32_t ContactSim::publishFrame() {
 
   for (int i = 0; i < 2; ++i) {
     const GelContactState& state = sim_->contact(static_cast<Finger>(i));
+    if (state.too_deep) {
+      ROS_WARN_THROTTLE(1.0,
+                        "contact_sim: the object is %.2f mm into %s's gel, deeper than the gel "
+                        "law's table reaches (%.2f mm): its force is extrapolated",
+                        state.penetration_m * 1e3, kSensorNames[i],
+                        sim_->config().gel_law.points().back().first * 1e3);
+    }
     // The patch costs a rasterization: skip it when nobody listens.
     if (contact_pub_[i].getNumSubscribers() == 0) continue;
     std_msgs::Header header;

@@ -56,6 +56,7 @@ TactileContact toContactMsg(const std_msgs::Header& header, const std::string& s
   msg.shear_force.y = state.shear_force_n.y();
   msg.shear_force.z = state.shear_force_n.z();
   msg.max_indentation = state.penetration_m;
+  msg.too_deep = state.too_deep;
   msg.contact_area = patch.area_m2;
   msg.centroid.x = patch.centroid_m.x();
   msg.centroid.y = patch.centroid_m.y();

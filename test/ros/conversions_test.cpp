@@ -45,6 +45,7 @@ TEST(ConversionsTest, ContactMessageCarriesEveryField) {
   state.normal_force_n = 12.5;
   state.shear_force_n = Eigen::Vector3d(0.1, 0.49, 0.0);
   state.penetration_m = 1e-3;
+  state.too_deep = true;
   ContactPatch patch;
   patch.area_m2 = 4.9e-4;
   patch.centroid_m = Eigen::Vector2d(-0.001, 0.002);
@@ -59,6 +60,7 @@ TEST(ConversionsTest, ContactMessageCarriesEveryField) {
   EXPECT_DOUBLE_EQ(msg.normal_force, 12.5);
   EXPECT_DOUBLE_EQ(msg.shear_force.y, 0.49);
   EXPECT_DOUBLE_EQ(msg.max_indentation, 1e-3);
+  EXPECT_TRUE(msg.too_deep);
   EXPECT_DOUBLE_EQ(msg.contact_area, 4.9e-4);
   EXPECT_DOUBLE_EQ(msg.centroid.x, -0.001);
   EXPECT_DOUBLE_EQ(msg.centroid.y, 0.002);

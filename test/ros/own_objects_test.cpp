@@ -1,6 +1,7 @@
 // rostests of what users bring through gripper_sim.launch: their own normal map instead of a
-// procedural material (own_texture.test), and the physics' friction without a material
-// (own_friction.test). Conditions are awaited with deadlines.
+// procedural material (own_texture.test), the physics' friction without a material
+// (own_friction.test), and their own mesh (own_mesh.test). Conditions are awaited with
+// deadlines.
 #include <cstdio>
 #include <map>
 #include <string>
@@ -8,11 +9,15 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
+#include "norm2tex/TactileContact.h"
 #include "wait_for.hpp"
 
 namespace {
@@ -97,6 +102,64 @@ TEST(OwnFriction, WithoutAMaterialTheGivenFrictionIsThePhysics) {
     ASSERT_TRUE(srv.response.success) << srv.response.message;
   }
   EXPECT_TRUE(srv.response.dropped);
+}
+
+TEST(OwnMesh, AUsersCylinderIsHeldStillAtEveryOffsetOfTheScene) {
+  // Once thrown 0.29 / 2.8 / 0.08 m at these offsets, through its right gel.
+  ros::NodeHandle nh;
+  std::map<std::string, std::map<ros::Time, norm2tex::TactileContact::ConstPtr>> contact;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string s : {"digit_left", "digit_right"}) {
+    subs.push_back(nh.subscribe<norm2tex::TactileContact>(
+        s + "/contact", 100, [&, s](const auto& m) { contact[s][m->header.stamp] = m; }));
+  }
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  ros::ServiceClient reset = nh.serviceClient<norm2tex::Reset>("/contact_sim/reset");
+  ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  ASSERT_TRUE(waitFor([&] { return subs[0].getNumPublishers() && subs[1].getNumPublishers(); },
+                      60.0));
+  const auto objectAt = [&](const ros::Time& t) {
+    // (Simulated time stands still between steps: wait on the wall clock.)
+    EXPECT_TRUE(waitFor([&] { return buffer.canTransform("world", "object", t); }, 10.0));
+    const auto& p = buffer.lookupTransform("world", "object", t).transform.translation;
+    return Eigen::Vector3d(p.x, p.y, p.z);
+  };
+  const auto frame = [&](int frames) {
+    norm2tex::Step srv;
+    srv.request.frames = frames;
+    EXPECT_TRUE(step.call(srv));
+    EXPECT_TRUE(srv.response.success) << srv.response.message;
+    return srv.response.stamp;
+  };
+  for (double offset : {0.0, 0.0125, 0.025}) {
+    norm2tex::Reset episode;
+    episode.request.seed = 0;
+    episode.request.height_offset = offset;
+    ASSERT_TRUE(reset.call(episode));
+    ASSERT_TRUE(episode.response.success) << episode.response.message;
+    const Eigen::Vector3d start = objectAt(frame(1));
+    const ros::Time t = frame(60);  // one second
+    const Eigen::Vector3d held = objectAt(t);
+    EXPECT_LT((held - start).norm(), 0.2e-3) << offset;
+    // Where the episode put it: centred between the gels, the offset above their centres.
+    EXPECT_NEAR(held.z(), 0.200 + offset, 0.3e-3) << offset;
+    EXPECT_NEAR(held.x(), 0.0, 0.3e-3) << offset;
+    EXPECT_NEAR(held.y(), 0.0, 0.3e-3) << offset;
+    ASSERT_TRUE(waitFor(
+        [&] { return contact["digit_left"].count(t) && contact["digit_right"].count(t); }, 10.0));
+    const auto& left = *contact["digit_left"][t];
+    const auto& right = *contact["digit_right"][t];
+    EXPECT_TRUE(left.in_contact && right.in_contact) << offset;
+    EXPECT_NEAR(left.normal_force, right.normal_force, 0.1 * left.normal_force) << offset;
+    for (const auto* c : {&left, &right}) {
+      EXPECT_NEAR(c->max_indentation, 1e-3, 0.1e-3) << offset;  // the scene's grip, adapted
+      EXPECT_FALSE(c->too_deep);
+    }
+  }
+  std::string mesh;
+  if (nh.getParam("/own_mesh_test/mesh", mesh)) std::remove(mesh.c_str());
 }
 
 }  // namespace
