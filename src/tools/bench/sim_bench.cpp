@@ -1,5 +1,8 @@
-// Physics cost of GripperSim (one core): ticks per second holding the default 30 mm cube, and
-// holding a 20k-triangle ball (its convex hull collides; the render mesh keeps every triangle).
+// Physics cost of GripperSim (one core): ticks per second holding the default 30 mm cube, a
+// 20k-triangle ball (recognised as a sphere: it collides exactly; the render mesh keeps every
+// triangle), the same ball forced to collide as its 10k-vertex hull (the worst case of a big
+// convex mesh), and a user's 128-facet cylinder (its hull).
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -32,6 +35,34 @@ std::string ballMesh20k() {
   return path;
 }
 
+// A 24 mm, 30 mm tall cylinder of 128 facets in millimetres, written once as an OBJ file.
+std::string cylinderMesh128() {
+  static const std::string path = [] {
+    const std::string file =
+        (std::filesystem::temp_directory_path() / "norm2tex_bench_cylinder_128.obj").string();
+    std::FILE* obj = std::fopen(file.c_str(), "w");
+    constexpr int kFacets = 128;
+    for (double z : {-15.0, 15.0}) {
+      for (int k = 0; k < kFacets; ++k) {
+        const double a = 2 * M_PI * k / kFacets;
+        std::fprintf(obj, "v %.6f %.6f %.1f\n", 12 * std::cos(a), 12 * std::sin(a), z);
+      }
+    }
+    for (int k = 0; k < kFacets; ++k) {
+      const int a = k + 1, b = (k + 1) % kFacets + 1;
+      std::fprintf(obj, "f %d %d %d\nf %d %d %d\n", a, b, b + kFacets, a, b + kFacets,
+                   a + kFacets);
+    }
+    for (int k = 1; k + 1 < kFacets; ++k) {
+      std::fprintf(obj, "f 1 %d %d\nf %d %d %d\n", k + 2, k + 1, kFacets + 1, kFacets + k + 1,
+                   kFacets + k + 2);
+    }
+    std::fclose(obj);
+    return file;
+  }();
+  return path;
+}
+
 void holdAndStep(benchmark::State& state, const norm2tex::GripperSimConfig& c) {
   norm2tex::GripperSim sim(c);
   sim.reset(1, 0.0);
@@ -50,6 +81,20 @@ void BM_GripperSim_Tick_Ball20kTriangles(benchmark::State& state) {
   holdAndStep(state, config(ballMesh20k()));
 }
 BENCHMARK(BM_GripperSim_Tick_Ball20kTriangles)->Unit(benchmark::kMicrosecond);
+
+void BM_GripperSim_Tick_Ball20kTrianglesHull(benchmark::State& state) {
+  norm2tex::GripperSimConfig c = config(ballMesh20k());
+  c.object.collision = "hull";
+  holdAndStep(state, c);
+}
+BENCHMARK(BM_GripperSim_Tick_Ball20kTrianglesHull)->Unit(benchmark::kMicrosecond);
+
+void BM_GripperSim_Tick_Cylinder128(benchmark::State& state) {
+  norm2tex::GripperSimConfig c = config(cylinderMesh128());
+  c.object.scale = 0.001;
+  holdAndStep(state, c);
+}
+BENCHMARK(BM_GripperSim_Tick_Cylinder128)->Unit(benchmark::kMicrosecond);
 
 // One 60 Hz sensor frame of contact_sim: 17 ticks plus both gels' contact patches.
 void BM_GripperSim_Frame_Cube(benchmark::State& state) {
