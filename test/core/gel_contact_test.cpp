@@ -118,6 +118,36 @@ TEST(GelContactTest, ALyingCapsuleLongerThanThePadTouchesAlongItUpToThePadsEdges
   }
 }
 
+TEST(GelContactTest, ABigHullIsSearchedFromItsDeepestVertexWithTheSameResult) {
+  // A 2,000-vertex ball hull, pressed at poses over the pad and across its edge: the search from
+  // the deepest vertex finds exactly the points of clipping every face.
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 2000; ++i) {  // a Fibonacci sphere of radius 8 mm
+    const double z = 1 - (2 * i + 1) / 2000.0, r = std::sqrt(1 - z * z), a = i * 2.399963;
+    points.push_back(0.008 * Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z));
+  }
+  const ConvexPolytope ball = ConvexPolytope::hullOf(points);
+  ASSERT_GT(ball.vertices.size(), 64u);
+  ConvexPolytope every_face = ball;
+  every_face.neighbours.clear();  // the face-by-face path
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0).normalized()).toRotationMatrix();
+  for (const Eigen::Vector3d& centre :
+       {Eigen::Vector3d(0, 0, 0.008 - 1e-3), Eigen::Vector3d(0.003, -0.002, 0.008 - 0.2e-3),
+        Eigen::Vector3d(kPad.half_width_m + 0.002, 0, 0.008 - 1.5e-3),
+        Eigen::Vector3d(0, 0, 0.008 + 1e-4)}) {
+    const auto searched = gelContactPoints(ball, at(centre, tilt), kPad);
+    const auto clipped = gelContactPoints(every_face, at(centre, tilt), kPad);
+    ASSERT_EQ(searched.size(), clipped.size()) << centre.transpose();
+    EXPECT_EQ(deepest(searched), deepest(clipped));
+    for (const GelContactPoint& p : searched) {
+      EXPECT_TRUE(std::any_of(clipped.begin(), clipped.end(), [&](const GelContactPoint& q) {
+        return (q.position - p.position).norm() < 1e-9;
+      }));
+    }
+  }
+}
+
 TEST(GelContactTest, SpanningPointsKeepTheDeepestAndTheWidestQuadrilateral) {
   std::vector<GelContactPoint> points;
   for (double x : {-2.0, -1.0, 0.0, 1.0, 2.0}) {

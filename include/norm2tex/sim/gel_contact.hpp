@@ -12,6 +12,10 @@ struct ConvexPolytope {
   std::vector<std::vector<int>> faces;
   /// Largest distance of a vertex from the origin: a bounding sphere for quick rejection.
   double radius = 0.0;
+  /// Per vertex: the vertices it shares an edge with, and the faces it is a corner of (so a
+  /// big hull is searched from its deepest vertex instead of face by face).
+  std::vector<std::vector<int>> neighbours;
+  std::vector<std::vector<int>> vertex_faces;
 
   /// The convex hull of `points` (coplanar faces merged into polygons). Throws Error for fewer
   /// than 4 points or points that span no volume.
@@ -43,7 +47,8 @@ struct GelContactPoint {
 /// mapped into the gel frame by `body_in_gel`) clipped to z < 0 and to the pad's rectangle.
 /// Exact for any convex polytope: every vertex of that region deeper than zero is returned
 /// (duplicates merged), so the deepest one is the object's indentation over the pad, the same
-/// geometry the renderer rasterises. Empty when nothing reaches into the pad.
+/// geometry the renderer rasterises. Empty when nothing reaches into the pad. Its cost grows
+/// with the part of a big polytope below the surface, not with the polytope.
 std::vector<GelContactPoint> gelContactPoints(const ConvexPolytope& polytope,
                                               const Eigen::Isometry3d& body_in_gel,
                                               const GelPad& pad);

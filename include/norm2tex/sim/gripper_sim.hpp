@@ -175,6 +175,11 @@ class GripperSim {
   std::vector<ConvexPolytope> contact_parts_;
   std::optional<Capsule> contact_capsule_;
   ObjectCollision collision_;
+  /// Where the object reaches into each gel (per part) after the last step, and the finger
+  /// position it was measured at.
+  std::array<std::vector<std::vector<GelContactPoint>>, 2> gel_points_;
+  bool points_valid_ = false;
+  double points_finger_position_m_ = 0.0;
   std::unique_ptr<World> world_;
   std::array<GelContactState, 2> contacts_;
   double command_ = 1.0;

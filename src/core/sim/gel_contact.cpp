@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <LinearMath/btConvexHullComputer.h>
@@ -45,11 +46,16 @@ void clipPolygon(std::vector<Eigen::Vector3d>& polygon, std::vector<Eigen::Vecto
   polygon.swap(scratch);
 }
 
-void addMerged(std::vector<GelContactPoint>& points, const Eigen::Vector3d& p) {
-  for (const GelContactPoint& q : points) {
-    if ((q.position - p).squaredNorm() <= kMergeDistance * kMergeDistance) return;
+// Adds p unless a point from `first` on is within kMergeDistance of it.
+void addMerged(std::vector<GelContactPoint>& points, size_t first, const Eigen::Vector3d& p) {
+  for (size_t i = first; i < points.size(); ++i) {
+    if ((points[i].position - p).squaredNorm() <= kMergeDistance * kMergeDistance) return;
   }
   points.push_back({p, -p.z()});
+}
+
+void addMerged(std::vector<GelContactPoint>& points, const Eigen::Vector3d& p) {
+  addMerged(points, 0, p);
 }
 
 double cross2(const Eigen::Vector3d& o, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -90,6 +96,24 @@ ConvexPolytope ConvexPolytope::hullOf(const std::vector<Eigen::Vector3d>& points
     }
     hull.faces.push_back(std::move(face));
   }
+  hull.neighbours.resize(hull.vertices.size());
+  hull.vertex_faces.resize(hull.vertices.size());
+  for (size_t f = 0; f < hull.faces.size(); ++f) {
+    const std::vector<int>& face = hull.faces[f];
+    for (size_t i = 0; i < face.size(); ++i) {
+      hull.vertex_faces[face[i]].push_back(static_cast<int>(f));
+      // Each edge is in two faces' loops, once each way: record it from one side only.
+      hull.neighbours[face[i]].push_back(face[(i + 1) % face.size()]);
+    }
+  }
+  for (size_t v = 0; v < hull.vertices.size(); ++v) {
+    for (int n : hull.neighbours[v]) {
+      std::vector<int>& back = hull.neighbours[n];
+      if (std::find(back.begin(), back.end(), static_cast<int>(v)) == back.end()) {
+        back.push_back(static_cast<int>(v));
+      }
+    }
+  }
   return hull;
 }
 
@@ -103,30 +127,105 @@ std::vector<GelContactPoint> gelContactPoints(const ConvexPolytope& polytope,
       std::abs(origin.y()) - polytope.radius > pad.half_height_m) {
     return points;
   }
-  std::vector<Eigen::Vector3d> in_gel(polytope.vertices.size());
-  for (size_t i = 0; i < in_gel.size(); ++i) in_gel[i] = body_in_gel * polytope.vertices[i];
-  std::vector<Eigen::Vector3d> polygon, scratch;
-  for (const std::vector<int>& face : polytope.faces) {
+  // Vertices mapped into the gel frame on demand; faces to clip: every face of a small
+  // polytope, else those around the vertices below the surface. Those are connected (on a
+  // convex polytope the vertices below any plane are), and their deepest is found by walking
+  // downhill from any vertex, so a 10k-vertex hull pressed 1 mm visits a few hundred.
+  const size_t count = polytope.vertices.size();
+  thread_local std::vector<Eigen::Vector3d> in_gel;
+  thread_local std::vector<std::uint32_t> mapped, visited_face;
+  thread_local std::uint32_t generation = 0;
+  if (mapped.size() < count) mapped.assign(count, 0), in_gel.resize(count);
+  if (visited_face.size() < polytope.faces.size()) visited_face.assign(polytope.faces.size(), 0);
+  if (++generation == 0) {  // wrapped: forget every stamp
+    std::fill(mapped.begin(), mapped.end(), 0);
+    std::fill(visited_face.begin(), visited_face.end(), 0);
+    generation = 1;
+  }
+  const auto vertex = [&](int i) -> const Eigen::Vector3d& {
+    if (mapped[i] != generation) {
+      in_gel[i] = body_in_gel * polytope.vertices[i];
+      mapped[i] = generation;
+    }
+    return in_gel[i];
+  };
+  thread_local std::vector<int> faces, below;  // below: the vertices under the surface
+  faces.clear();
+  below.clear();
+  constexpr size_t kSmall = 64;
+  if (count <= kSmall || polytope.neighbours.size() != count) {
+    for (size_t f = 0; f < polytope.faces.size(); ++f) faces.push_back(static_cast<int>(f));
+    for (size_t v = 0; v < count; ++v) {
+      if (vertex(static_cast<int>(v)).z() < 0.0) below.push_back(static_cast<int>(v));
+    }
+  } else {
+    int lowest = 0;
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (int n : polytope.neighbours[lowest]) {
+        if (vertex(n).z() < vertex(lowest).z()) lowest = n, moved = true;
+      }
+    }
+    if (vertex(lowest).z() >= 0.0) return points;
+    thread_local std::vector<int> queue;
+    thread_local std::vector<std::uint32_t> queued;
+    if (queued.size() < count) queued.assign(count, 0);
+    if (generation == 1) std::fill(queued.begin(), queued.end(), 0);
+    queue.assign(1, lowest);
+    queued[lowest] = generation;
+    for (size_t q = 0; q < queue.size(); ++q) {
+      const int v = queue[q];
+      below.push_back(v);
+      for (int f : polytope.vertex_faces[v]) {
+        if (visited_face[f] != generation) visited_face[f] = generation, faces.push_back(f);
+      }
+      for (int n : polytope.neighbours[v]) {
+        if (queued[n] != generation && vertex(n).z() < 0.0) {
+          queued[n] = generation;
+          queue.push_back(n);
+        }
+      }
+    }
+  }
+  // The region's corners: the polytope's own vertices under the surface over the pad, once
+  // each, and where faces crossing the pad's rim are cut by it (clipping faces that lie inside
+  // the rim would only give their own corners again, and the surface's crossings are 0 deep).
+  const auto overPad = [&](const Eigen::Vector3d& p) {
+    return std::abs(p.x()) <= pad.half_width_m && std::abs(p.y()) <= pad.half_height_m;
+  };
+  for (int v : below) {
+    if (overPad(vertex(v))) points.push_back({vertex(v), -vertex(v).z()});
+  }
+  const size_t own_corners = points.size();
+  thread_local std::vector<Eigen::Vector3d> polygon, scratch;
+  for (int f : faces) {
+    const std::vector<int>& face = polytope.faces[f];
     double min_z = std::numeric_limits<double>::infinity();
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(min_z), hi = -lo;
     for (int i : face) {
-      min_z = std::min(min_z, in_gel[i].z());
-      lo = lo.cwiseMin(in_gel[i].head<2>());
-      hi = hi.cwiseMax(in_gel[i].head<2>());
+      const Eigen::Vector3d& p = vertex(i);
+      min_z = std::min(min_z, p.z());
+      lo = lo.cwiseMin(p.head<2>());
+      hi = hi.cwiseMax(p.head<2>());
     }
-    if (min_z >= 0.0 || lo.x() > pad.half_width_m || hi.x() < -pad.half_width_m ||
+    const bool inside_rim = lo.x() >= -pad.half_width_m && hi.x() <= pad.half_width_m &&
+                            lo.y() >= -pad.half_height_m && hi.y() <= pad.half_height_m;
+    if (min_z >= 0.0 || inside_rim || lo.x() > pad.half_width_m || hi.x() < -pad.half_width_m ||
         lo.y() > pad.half_height_m || hi.y() < -pad.half_height_m) {
       continue;
     }
     polygon.clear();
-    for (int i : face) polygon.push_back(in_gel[i]);
+    for (int i : face) polygon.push_back(vertex(i));
     clipPolygon(polygon, scratch, 2, 1.0, 0.0);
     clipPolygon(polygon, scratch, 0, 1.0, pad.half_width_m);
     clipPolygon(polygon, scratch, 0, -1.0, pad.half_width_m);
     clipPolygon(polygon, scratch, 1, 1.0, pad.half_height_m);
     clipPolygon(polygon, scratch, 1, -1.0, pad.half_height_m);
     for (const Eigen::Vector3d& p : polygon) {
-      if (p.z() < 0.0) addMerged(points, p);
+      if (!(p.z() < 0.0)) continue;
+      const bool own = std::any_of(face.begin(), face.end(),
+                                   [&](int i) { return vertex(i) == p; });
+      if (!own) addMerged(points, own_corners, p);
     }
   }
   return points;

@@ -293,6 +293,7 @@ Eigen::Isometry3d GripperSim::objectInWorld() const {
 }
 
 void GripperSim::buildWorld(double object_height_m) {
+  points_valid_ = false;
   world_ = std::make_unique<World>();
   btDiscreteDynamicsWorld& w = world_->world;
   const PhysicsOptions& p = config_.physics;
@@ -422,7 +423,12 @@ void GripperSim::updateGelContacts() {
     const btRigidBody& gel = *world_->gels[i];
     const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
     const Eigen::Vector3d normal_on_object = -gel_in_world.linear().col(2);  // into the gel
-    const std::vector<std::vector<GelContactPoint>> parts = gelPoints(i);
+    // The last step's measurement still holds unless the finger has moved since (the object
+    // has not: nothing moves it between a step and the next tick's contacts).
+    if (!points_valid_ || finger_position_m_ != points_finger_position_m_) {
+      gel_points_[i] = gelPoints(i);
+    }
+    const std::vector<std::vector<GelContactPoint>>& parts = gel_points_[i];
     for (size_t k = 0; k < parts.size(); ++k) {
       btPersistentManifold& manifold = *world_->manifolds[i][k];
       manifold.refreshContactPoints(gel.getWorldTransform(), object.getWorldTransform());
@@ -511,7 +517,8 @@ void GripperSim::measureContacts(double dt) {
     state = GelContactState{};
     state.object_in_gel = gel_in_world.inverse() * object_in_world;
     // The indentation at the pose the step ended in: what the renderer draws.
-    for (const std::vector<GelContactPoint>& part : gelPoints(i)) {
+    gel_points_[i] = gelPoints(i);
+    for (const std::vector<GelContactPoint>& part : gel_points_[i]) {
       for (const GelContactPoint& p : part) state.penetration_m = std::max(state.penetration_m, p.depth);
     }
     state.too_deep = state.penetration_m > deepest_law_point;
@@ -527,6 +534,8 @@ void GripperSim::measureContacts(double dt) {
     state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
     state.shear_force_n.z() = 0.0;
   }
+  points_valid_ = true;
+  points_finger_position_m_ = finger_position_m_;
   // Dropped: free of both gels and below their lower edge.
   const double lower_edge = config_.gripper.base_height_m - config_.gel_height_m / 2.0;
   if (!contacts_[0].in_contact && !contacts_[1].in_contact &&
