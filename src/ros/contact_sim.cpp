@@ -170,6 +170,13 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
            "deep where the gels reach)",
            collision.kind.c_str(), collision.parts, collision.parts == 1 ? "" : "s",
            collision.hull_deviation_m * 1e3);
+  const auto [low, high] = sim_->heightOffsetRange();
+  if (low > config.episode.height_offset_low_m || high < config.episode.height_offset_high_m) {
+    ROS_INFO("contact_sim: height offsets %.1f-%.1f mm (the scene's %.1f-%.1f mm where the "
+             "object's sides meet the gel pads)",
+             low * 1e3, high * 1e3, config.episode.height_offset_low_m * 1e3,
+             config.episode.height_offset_high_m * 1e3);
+  }
 }
 
 ros::Time ContactSim::frameStamp() const {

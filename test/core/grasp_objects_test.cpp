@@ -183,8 +183,11 @@ struct GraspObject {
   std::string name;
   Mesh mesh;
   double mass_kg;
-  double max_offset_mm;  // the highest height offset at which its grip lies on the pads
+  double max_offset_mm;  // the highest height offset at which its sides meet the pads
   std::string collision;  // what "auto" should choose
+  // How far apart its vertices lie around a round side, mm: a tessellated side's band of
+  // vertices within the gel's reach ends up to that much short of the round side's.
+  double vertex_spacing_mm = 0.0;
 };
 
 void PrintTo(const GraspObject& object, std::ostream* os) { *os << object.name; }
@@ -194,7 +197,7 @@ std::vector<GraspObject> objects() {
   for (double size : {20.0, 30.0, 40.0}) {
     const double h = size / 2;
     set.push_back({"cube" + std::to_string(int(size)), box({-h, -h, -h}, {h, h, h}), 0.05,
-                   std::min(25.0, h + 12.8 - 3), "box"});
+                   std::min(25.0, h + 12.8 - 1), "box"});
   }
   for (double d : {24.0, 30.0, 40.0}) {
     for (int facets : {32, 128}) {
@@ -202,13 +205,15 @@ std::vector<GraspObject> objects() {
         const std::string name = std::string(lying ? "lying" : "standing") + "_cylinder" +
                                  std::to_string(int(d)) + "_" + std::to_string(facets);
         // Standing: 30 mm tall, gripped on its side anywhere along it; lying: 40 mm long, the
-        // gels meet its round side at its equator, which must stay on the pads.
+        // gels meet its round side within 2 mm of its equator, which must reach the pads.
+        const double band = std::sqrt(d * d / 4 - (d / 2 - 2) * (d / 2 - 2));
         set.push_back({name, cylinder(d, lying ? 40 : 30, facets, lying), 0.05,
-                       lying ? 9.0 : 25.0, "hull"});
+                       lying ? 12.8 + band - 1 : 25.0, "hull", M_PI * d / facets});
       }
     }
   }
-  set.push_back({"sphere", roundEnded(12, 0, 24, 48), 0.03, 9.0, "sphere"});
+  set.push_back({"sphere", roundEnded(12, 0, 24, 48), 0.03, 12.8 + std::sqrt(144.0 - 100.0) - 1,
+                 "sphere", M_PI * 12 / 48});
   set.push_back({"capsule", roundEnded(10, 20, 12, 48), 0.03, 25.0, "capsule"});
   set.push_back({"bottle",
                  revolve({{12, -45}, {12, 15}, {9, 23}, {5, 29}, {5, 45}}, 64), 0.08, 25.0, "hull"});
@@ -228,9 +233,7 @@ class GraspObjectTest : public ::testing::TestWithParam<GraspObject> {
     c.object.mesh = dir_.path(object.name + ".obj");
     c.object.scale = 0.001;
     c.object.mass_kg = object.mass_kg;
-    c.episode.height_offset_low_m = 0.0;
-    c.episode.height_offset_high_m = object.max_offset_mm * 1e-3;
-    return c;
+    return c;  // the scene's offsets, 0-25 mm
   }
   test::ScratchDirectory dir_;
 };
@@ -239,14 +242,20 @@ double rotationDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
 }
 
-TEST_P(GraspObjectTest, CollidesAsItsShape) {
+TEST_P(GraspObjectTest, CollidesAsItsShapeWhereItsSidesMeetThePads) {
   GripperSim sim(config());
   EXPECT_EQ(sim.collision().kind, GetParam().collision) << GetParam().name;
+  // The scene's offsets at which its sides, within the gel's 2 mm reach, overlap the pads
+  // (+-12.8 mm) by 1 mm: a tessellated side reaches a little less far than the round one.
+  EXPECT_EQ(sim.heightOffsetRange().first, 0.0);
+  EXPECT_LE(sim.heightOffsetRange().second, GetParam().max_offset_mm * 1e-3 + 1e-9);
+  EXPECT_GE(sim.heightOffsetRange().second,
+            (GetParam().max_offset_mm - GetParam().vertex_spacing_mm) * 1e-3 - 1e-9);
 }
 
 TEST_P(GraspObjectTest, HoldsStillForTenSecondsWithBothGelsAlike) {
   GripperSim sim(config());
-  const EpisodeStart start = sim.reset(1, 0.5 * GetParam().max_offset_mm * 1e-3);
+  const EpisodeStart start = sim.reset(1, 0.5 * sim.heightOffsetRange().second);
   EXPECT_GT(start.grasp_opening, 0.0);
   const GelContactState& left = sim.contact(Finger::kLeft);
   const GelContactState& right = sim.contact(Finger::kRight);
@@ -284,18 +293,22 @@ TEST_P(GraspObjectTest, HoldsStillForTenSecondsWithBothGelsAlike) {
 }
 
 TEST_P(GraspObjectTest, PhysicsIndentationIsTheRenderedOne) {
+  // Where the deepest contact is on the camera's view (the middle 12.8 x 17 mm of the pad):
+  // at the gel centres and 5 mm up.
   GripperSim sim(config());
-  sim.reset(2, 0.5 * GetParam().max_offset_mm * 1e-3);
   ContactPatchMeter meter(makeDigitSensorModel());
-  for (Finger finger : {Finger::kLeft, Finger::kRight}) {
+  for (const auto& [offset, finger] :
+       {std::pair{0.0, Finger::kLeft}, {0.0, Finger::kRight}, {0.005, Finger::kLeft},
+        {0.005, Finger::kRight}}) {
+    if (finger == Finger::kLeft) sim.reset(2, offset);
     const GelContactState& c = sim.contact(finger);
     const ContactPatch patch = meter.measure(sim.object().mesh, c.object_in_gel);
-    ASSERT_GT(patch.pixels, 0) << "finger " << static_cast<int>(finger);
-    RecordProperty(static_cast<int>(finger) ? "right_physics_minus_rendered_um"
-                                            : "left_physics_minus_rendered_um",
+    ASSERT_GT(patch.pixels, 0) << "finger " << static_cast<int>(finger) << " offset " << offset;
+    RecordProperty(std::string(static_cast<int>(finger) ? "right" : "left") + "_at_" +
+                       std::to_string(static_cast<int>(offset * 1e3)) + "mm_physics_minus_rendered_um",
                    std::to_string((c.penetration_m - patch.max_indentation_m) * 1e6));
     EXPECT_NEAR(c.penetration_m, patch.max_indentation_m, 0.15e-3)
-        << "finger " << static_cast<int>(finger);
+        << "finger " << static_cast<int>(finger) << " offset " << offset;
   }
 }
 
@@ -321,7 +334,7 @@ TEST_P(GraspObjectTest, OpeningSlowlyDropsIt) {
 TEST_P(GraspObjectTest, ResetPlacesItAtEveryOffsetInRange) {
   GripperSim sim(config());
   const double base = sim.config().gripper.base_height_m;
-  const double high = GetParam().max_offset_mm * 1e-3;
+  const double high = sim.heightOffsetRange().second;
   for (double offset : {0.0, 0.5 * high, high}) {
     sim.reset(4, offset);
     ASSERT_TRUE(sim.contact(Finger::kLeft).in_contact) << offset;
@@ -349,10 +362,31 @@ TEST(GraspObjectsTest, AnOffsetWhereTheObjectMissesThePadsIsRefusedWithTheReason
   c.object.scale = 0.001;
   c.object.mass_kg = 0.03;
   GripperSim sim(c);
-  // 20 mm up, the ball's equator is 7 mm above the pads' upper edge (12.8 mm).
-  test::expectError([&] { sim.reset(1, 0.020); }, {"does not reach both gel pads", "20 mm"});
+  // 20 mm up, the ball's equator is 7 mm above the pads' upper edge (12.8 mm), and the band
+  // a gel reaches 2 mm into it ends above it.
+  test::expectError([&] { sim.reset(1, 0.020); }, {"sides miss the gel pads", "valid for this object"});
   EXPECT_NO_THROW(sim.reset(1, 0.005));
   EXPECT_TRUE(sim.contact(Finger::kLeft).in_contact);
+  // Drawn offsets come from where it can be gripped.
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    EXPECT_LE(sim.reset(seed).height_offset_m, sim.heightOffsetRange().second);
+  }
+}
+
+TEST(GraspObjectsTest, ObjectsTheGripperCannotGraspAreStartUpErrors) {
+  GripperSimConfig c;
+  setGelFromSensor(makeDigitSensorModel(), c);
+  c.object.mesh = "sphere:5";
+  c.episode.height_offset_low_m = 0.020;  // its sides are never on the pads
+  test::expectError([&] { GripperSim sim(c); },
+                    {"cannot be gripped at any height offset", "[20, 25]", "pads +-12.8"});
+  c.episode.height_offset_low_m = 0.0;
+  c.object.mesh = "box:10x10x10";
+  c.gripper.min_gap_m = 0.009;  // closed, 9 mm apart: cannot indent a 10 mm cube 1 mm a side
+  test::expectError([&] { GripperSim sim(c); }, {"10 mm wide", "cannot indent both gels"});
+  c.gripper.min_gap_m = 0.0;
+  c.object.mesh = "box:10x39x10";  // open 40 mm: less than 1 mm clear of each gel
+  test::expectError([&] { GripperSim sim(c); }, {"39 mm wide", "max_gap_mm = 40"});
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -82,23 +83,31 @@ struct ObjectCollision {
 class GripperSim {
  public:
   /// Loads the object (loadObjectMesh) and builds the world with the object seated at the
-  /// episode's lowest height offset and the fingers open; call reset() to start an episode.
-  /// Throws Error for an invalid config, an unreadable mesh, or an object wider than max_gap.
+  /// lowest height offset of heightOffsetRange() and the fingers open; call reset() to start an episode.
+  /// Throws Error for an invalid config, an unreadable mesh, an object wider than max_gap (or
+  /// too thin for the closed gripper to reach the grip), or one whose sides miss the gel pads
+  /// at every height offset of the scene.
   explicit GripperSim(const GripperSimConfig& config);
   ~GripperSim();
   GripperSim(const GripperSim&) = delete;
   GripperSim& operator=(const GripperSim&) = delete;
 
-  /// Re-seats the object between the fully open gels at `height_offset_m` (or, when absent, one
-  /// drawn uniformly from the configured range with `seed`), centred on its extent along the
-  /// grip axis so it touches neither gel, and grasps it without gravity on it: the fingers
+  /// Height offsets (object centre above the gel centres, m) reset() accepts and draws from:
+  /// the scene's episode.height_offset_mm where the object's sides, within the gel's reach
+  /// of its extent along the grip axis, overlap the gel pads by 1 mm or more.
+  std::pair<double, double> heightOffsetRange() const { return height_offset_range_; }
+
+  /// Re-seats the object at `height_offset_m` (or, when absent, one drawn uniformly from
+  /// heightOffsetRange() with `seed`), centred on its extent along the grip axis between gels
+  /// opened 1 mm wider than it on each side, and grasps it without gravity on it: the fingers
   /// close until both gels touch, then to the grip that indents each by
   /// episode.grasp_indentation_m (or carries episode.grasp_force_n), measured on the object's
   /// real surface; with episode.grasp_opening >= 0 they close to that opening instead. Then
   /// the object settles under gravity for episode.settle_s. Simulated time keeps running
-  /// through it. Throws Error (and changes nothing) for an offset outside the scene's
-  /// [episode.height_offset_low_m, height_offset_high_m] or NaN; throws Error naming the offset
-  /// when the object's sides miss the gel pads there (the fingers are then left open).
+  /// through it. Throws Error (and changes nothing) for NaN or an offset outside the scene's
+  /// [episode.height_offset_low_m, height_offset_high_m] or heightOffsetRange(); throws Error
+  /// naming the offset when the closing gels still miss the object (the fingers are then left
+  /// open).
   EpisodeStart reset(std::uint64_t seed, std::optional<double> height_offset_m = std::nullopt);
 
   /// Normalised opening command, 0 = closed (gap min_gap) ... 1 = open (gap max_gap). Throws
@@ -148,6 +157,7 @@ class GripperSim {
 
   /// Chooses the object's collision (see ObjectOptions::collision) about the body origin.
   void makeCollision(const Eigen::Vector3d& centre);
+  void findHeightOffsetRange(const Eigen::Vector3d& centre);
   void buildWorld(double object_height_m);
   void moveFingers(double dt);
   /// Calls visit(btManifoldPoint&) for every contact point between gel `gel_index` and the
@@ -175,6 +185,7 @@ class GripperSim {
   std::vector<ConvexPolytope> contact_parts_;
   std::optional<Capsule> contact_capsule_;
   ObjectCollision collision_;
+  std::pair<double, double> height_offset_range_;
   /// Where the object reaches into each gel (per part) after the last step, and the finger
   /// position it was measured at.
   std::array<std::vector<std::vector<GelContactPoint>>, 2> gel_points_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -29,6 +30,9 @@ constexpr double kContactBreakingM = 3e-4;
 // "auto" collision decomposes a mesh whose hull bridges a hollow deeper than this on a side
 // facing the gels: the tolerance the physics keeps to the rendered indentation.
 constexpr double kMaxHullDeviationM = 0.15e-3;
+// An object's side must overlap the gel pads by this much (height) at a height offset reset()
+// accepts.
+constexpr double kMinPadOverlap = 1e-3;
 // Collision filter groups: the gels never collide through Bullet (the package makes their
 // contacts), the object still meets the floor.
 constexpr int kGelGroup = 1 << 6;
@@ -150,9 +154,10 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   }
   // Built once: resets rebuild the world but reuse the (stateless) shapes.
   makeCollision(centre);
+  findHeightOffsetRange(centre);
   command_ = 1.0;
   finger_position_m_ = config_.gripper.max_gap_m / 2.0;
-  buildWorld(config_.episode.height_offset_low_m);
+  buildWorld(height_offset_range_.first);
 }
 
 GripperSim::~GripperSim() = default;
@@ -220,6 +225,44 @@ void GripperSim::makeCollision(const Eigen::Vector3d& centre) {
   object_shapes_.push_back(bulletHull(points));
   contact_parts_.push_back(std::move(hull));
   collision_.kind = "hull";
+}
+
+void GripperSim::findHeightOffsetRange(const Eigen::Vector3d& centre) {
+  // The gels meet the object within their reach (the law's deepest point) of its extent along
+  // the grip axis: both sides' bands must overlap the pads' height, or no grasp can be made.
+  const EpisodeOptions& e = config_.episode;
+  const double reach = config_.gel_law.points().back().first;
+  const double pad = config_.gel_height_m / 2;
+  const Eigen::AlignedBox3d bounds = object_.mesh.bounds().cast<double>();
+  double low = e.height_offset_low_m, high = e.height_offset_high_m;
+  std::ostringstream sides;
+  for (double side : {1.0, -1.0}) {
+    const double extreme = side > 0 ? bounds.max().y() : bounds.min().y();
+    double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+    for (const Eigen::Vector3f& v : object_.mesh.vertices()) {
+      if (side * (extreme - v.y()) <= reach) {
+        z_lo = std::min(z_lo, v.z() - centre.z());
+        z_hi = std::max(z_hi, v.z() - centre.z());
+      }
+    }
+    // At offset o its side spans o + [z_lo, z_hi]; the pads [-pad, pad]; they must overlap by
+    // kMinPadOverlap, or the gels would meet it only at their very rim.
+    low = std::max(low, -pad - z_hi + kMinPadOverlap);
+    high = std::min(high, pad - z_lo - kMinPadOverlap);
+    sides << (side > 0 ? "" : ", ") << (side > 0 ? "+y" : "-y") << " side " << z_lo * 1e3
+          << " to " << z_hi * 1e3;
+  }
+  if (low > high) {
+    std::ostringstream message;
+    message << "object '" << config_.object.mesh
+            << "' cannot be gripped at any height offset of episode.height_offset_mm ["
+            << e.height_offset_low_m * 1e3 << ", " << e.height_offset_high_m * 1e3
+            << "]: within " << reach * 1e3 << " mm of its extent along the grip axis its sides span"
+            << " z = " << sides.str() << " mm about its centre, the gel pads +-" << pad * 1e3
+            << " mm (with " << kMinPadOverlap * 1e3 << " mm of overlap)";
+    throw Error(message.str());
+  }
+  height_offset_range_ = {low, high};
 }
 
 double GripperSim::objectMinHalfSizeM() const {
@@ -605,10 +648,9 @@ double GripperSim::closeOnTheObject(double offset_m) {
 EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_offset_m) {
   const EpisodeOptions& e = config_.episode;
   std::mt19937_64 rng(seed);
-  const double offset = height_offset_m
-                            ? *height_offset_m
-                            : e.height_offset_low_m +
-                                  uniform01(rng) * (e.height_offset_high_m - e.height_offset_low_m);
+  const auto [low, high] = height_offset_range_;
+  const double offset =
+      height_offset_m ? *height_offset_m : low + uniform01(rng) * (high - low);
   // Outside the scene's range the grasp is not the scene's (too high: the object barely touches
   // the gels; below: it tumbles), so a given offset is refused rather than clamped.
   if (!(offset >= e.height_offset_low_m && offset <= e.height_offset_high_m)) {
@@ -616,6 +658,12 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
     message << "height offset " << offset << " m is out of the scene's range; valid: ["
             << e.height_offset_low_m << ", " << e.height_offset_high_m
             << "] m (episode.height_offset_mm)";
+    throw Error(message.str());
+  }
+  if (!(offset >= low && offset <= high)) {
+    std::ostringstream message;
+    message << "height offset " << offset << " m: the object's sides miss the gel pads there; "
+            << "valid for this object: [" << low << ", " << high << "] m";
     throw Error(message.str());
   }
   EpisodeStart start;
