@@ -129,6 +129,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   object_marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);
   joints_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   episode_pub_ = nh_.advertise<EpisodeInfo>("episode", 1, /*latch=*/true);
+  episode_state_pub_ = nh_.advertise<EpisodeState>("episode_state", 1, /*latch=*/true);
   for (int i = 0; i < 2; ++i) {
     contact_pub_[i] = nh_.advertise<TactileContact>(std::string(kSensorNames[i]) + "/contact", 10);
   }
@@ -209,7 +210,21 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   info.height_offset = start.height_offset_m;
   info.num_shards = 1;
   episode_pub_.publish(info);
+  episode_state_.header = info.header;
+  episode_state_.episode = info.episode;
+  episode_state_.dropped = sim_->dropped();
+  episode_state_pub_.publish(episode_state_);
   return info;
+}
+
+void ContactSim::publishStateChange(const ros::Time& stamp) {
+  if (sim_->dropped() == episode_state_.dropped) return;
+  episode_state_.header.stamp = stamp;
+  episode_state_.dropped = sim_->dropped();
+  episode_state_pub_.publish(episode_state_);
+  if (episode_state_.dropped) {
+    ROS_INFO("contact_sim: episode %u: the object dropped out of the gripper", episode_);
+  }
 }
 
 void ContactSim::applyCommandOrThrow(const GripperCommand& command) {
@@ -409,6 +424,8 @@ std::uint32_t ContactSim::publishFrame() {
   tf2_msgs::TFMessage tf;
   tf.transforms = std::move(transforms);
   tf_pub_.publish(tf);
+
+  publishStateChange(stamp);
 
   sensor_msgs::JointState joints;
   joints.header.stamp = stamp;

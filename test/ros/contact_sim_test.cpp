@@ -15,6 +15,7 @@
 
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/EpisodeState.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
@@ -100,8 +101,15 @@ TEST(RealTime, TfJointStatesAndContactsPublishWithOneStamp) {
 
 TEST(RealTime, OpeningTheGripperDropsTheCubeAndBadCommandsChangeNothing) {
   Listener l;
+  norm2tex::EpisodeState::ConstPtr state;
+  ros::Subscriber state_sub = l.nh.subscribe<norm2tex::EpisodeState>(
+      "/episode_state", 10, [&](const auto& m) { state = m; });
   ros::Publisher command = l.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 10, true);
   ASSERT_TRUE(waitFor([&] { return l.joints && command.getNumSubscribers() > 0; }, 20.0));
+  // Latched: the episode's state reaches a late subscriber. Held, not dropped.
+  ASSERT_TRUE(waitFor([&] { return state && l.episode; }, 20.0));
+  EXPECT_FALSE(state->dropped);
+  EXPECT_EQ(state->episode, l.episode->episode);
   const double held = l.joints->position[0];
   norm2tex::GripperCommand bad;
   bad.mode = norm2tex::GripperCommand::ABSOLUTE;
@@ -125,6 +133,10 @@ TEST(RealTime, OpeningTheGripperDropsTheCubeAndBadCommandsChangeNothing) {
       waitFor([&] { return !l.contacts[0]->in_contact && !l.contacts[1]->in_contact; }, 20.0))
       << "the cube never left the gels";
   EXPECT_TRUE(waitFor([&] { return l.joints->position[0] > 0.0199; }, 20.0));
+  // Real time has no ~step to return `dropped`: /episode_state says it, stamped with the frame.
+  EXPECT_TRUE(waitFor([&] { return state->dropped; }, 20.0)) << "/episode_state never said dropped";
+  EXPECT_EQ(state->episode, l.episode->episode);
+  EXPECT_GT(state->header.stamp, l.episode->header.stamp);
 }
 
 TEST(BadInput, StartUpErrorsExitNonZeroNamingTheCause) {
