@@ -13,6 +13,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "conversions.hpp"
 #include "markers.hpp"
@@ -134,6 +135,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     contact_pub_[i] = nh_.advertise<TactileContact>(std::string(kSensorNames[i]) + "/contact", 10);
   }
   startEpisode(params_.seed, params_.height_offset);
+  publishStaticTransforms();
 
   lock_step_ = std::make_unique<LockStep>(
       private_nh_,
@@ -171,6 +173,20 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
            "deep where the gels reach)",
            collision.kind.c_str(), collision.parts, collision.parts == 1 ? "" : "s",
            collision.hull_deviation_m * 1e3);
+}
+
+void ContactSim::publishStaticTransforms() {
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  for (int i = 0; i < 2; ++i) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = frameStamp();
+    t.header.frame_id = kFingerFrames[i];
+    t.child_frame_id = kGelFrames[i];
+    t.transform = ros_conversions::toTransformMsg(GripperSim::gelInFinger(static_cast<Finger>(i)));
+    transforms.push_back(t);
+  }
+  static_tf_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
+  static_tf_->sendTransform(transforms);
 }
 
 ros::Time ContactSim::frameStamp() const {
@@ -418,7 +434,6 @@ std::uint32_t ContactSim::publishFrame() {
   for (int i = 0; i < 2; ++i) {
     const Finger finger = static_cast<Finger>(i);
     transforms.push_back(stamped("gripper_base", kFingerFrames[i], sim_->fingerInBase(finger)));
-    transforms.push_back(stamped(kFingerFrames[i], kGelFrames[i], GripperSim::gelInFinger(finger)));
   }
   transforms.push_back(stamped("world", "object", sim_->objectInWorld()));
   tf2_msgs::TFMessage tf;

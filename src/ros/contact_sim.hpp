@@ -11,6 +11,7 @@
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "lock_step.hpp"
 #include "norm2tex/EpisodeInfo.h"
@@ -88,6 +89,8 @@ class ContactSim {
   /// Applies a command; throws Error naming what is wrong (and changes nothing) when invalid.
   void applyCommandOrThrow(const GripperCommand& command);
   EpisodeInfo startEpisode(std::int64_t seed, double height_offset);
+  /// The fixed finger -> gel transforms, once, on /tf_static.
+  void publishStaticTransforms();
   /// Publishes /episode_state when the episode's state (a drop) differs from the last published.
   void publishStateChange(const ros::Time& stamp);
   /// Advances one sensor frame of physics and publishes it.
@@ -122,6 +125,8 @@ class ContactSim {
   ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, episode_state_pub_, frame_pub_,
       contact_pub_[2];
   ros::Publisher markers_pub_, object_marker_pub_;
+  /// /tf_static (latched); made once everything is valid (it advertises when constructed).
+  std::unique_ptr<tf2_ros::StaticTransformBroadcaster> static_tf_;
   ros::Subscriber command_sub_;
   ros::ServiceServer reset_srv_, step_srv_;
 

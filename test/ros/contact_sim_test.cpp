@@ -4,16 +4,20 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/EpisodeState.h"
 #include "norm2tex/GripperCommand.h"
@@ -97,6 +101,48 @@ TEST(RealTime, TfJointStatesAndContactsPublishWithOneStamp) {
         norm2tex::loadSensorModel(NORM2TEX_SOURCE_DIR "/config/digit.yaml");
     EXPECT_NEAR(c.contact_area, sensor.gelWidthMm() * sensor.gelHeightMm() * 1e-6, 1e-6);
   }
+}
+
+// The gel frames never move on their fingers: they are on /tf_static (latched, once), not among
+// the 60 Hz /tf.
+TEST(RealTime, FixedGelTransformsAreStatic) {
+  ros::NodeHandle nh;
+  std::vector<geometry_msgs::TransformStamped> statics;
+  std::set<std::string> tf_children;
+  int tf_messages = 0;
+  ros::Subscriber static_sub = nh.subscribe<tf2_msgs::TFMessage>(
+      "/tf_static", 10, [&](const auto& m) {
+        statics.insert(statics.end(), m->transforms.begin(), m->transforms.end());
+      });
+  ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const auto& m) {
+    ++tf_messages;
+    for (const auto& t : m->transforms) tf_children.insert(t.child_frame_id);
+  });
+  // Half a second of frames, and the latched static transforms.
+  ASSERT_TRUE(waitFor([&] { return tf_messages >= 30 && statics.size() >= 2; }, 20.0))
+      << tf_messages << " /tf messages, " << statics.size() << " static transforms";
+  EXPECT_EQ(statics.size(), 2u);
+  for (const auto& t : statics) {
+    const bool left = t.child_frame_id == "digit_left_gel";
+    EXPECT_TRUE(left || t.child_frame_id == "digit_right_gel") << t.child_frame_id;
+    EXPECT_EQ(t.header.frame_id, left ? "finger_left" : "finger_right");
+    const Eigen::Isometry3d expected = norm2tex::GripperSim::gelInFinger(
+        left ? norm2tex::Finger::kLeft : norm2tex::Finger::kRight);
+    EXPECT_NEAR(t.transform.translation.x, expected.translation().x(), 1e-9);
+    EXPECT_NEAR(t.transform.translation.y, expected.translation().y(), 1e-9);
+    EXPECT_NEAR(t.transform.translation.z, expected.translation().z(), 1e-9);
+    const Eigen::Quaterniond q(expected.linear());
+    EXPECT_NEAR(std::abs(t.transform.rotation.w * q.w() + t.transform.rotation.x * q.x() +
+                         t.transform.rotation.y * q.y() + t.transform.rotation.z * q.z()),
+                1.0, 1e-9)
+        << t.child_frame_id;
+  }
+  for (const char* moving : {"gripper_base", "finger_left", "finger_right", "object"}) {
+    EXPECT_EQ(tf_children.count(moving), 1u) << moving << " is not on /tf";
+  }
+  EXPECT_EQ(tf_children.count("digit_left_gel"), 0u);
+  EXPECT_EQ(tf_children.count("digit_right_gel"), 0u);
+
 }
 
 TEST(RealTime, OpeningTheGripperDropsTheCubeAndBadCommandsChangeNothing) {
