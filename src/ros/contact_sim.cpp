@@ -124,7 +124,9 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   owns_clock_ = use_sim_time;
 
   tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
-  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  // Only the clock's owner advertises /clock: a silent publisher would let a node that waits for
+  // simulated time believe a clock is there.
+  if (owns_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   frame_pub_ = private_nh_.advertise<SimFrame>("frame", 100);
   markers_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   object_marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);

@@ -104,8 +104,9 @@ TEST(RealTime, TfJointStatesAndContactsPublishWithOneStamp) {
 }
 
 // The gel frames never move on their fingers: they are on /tf_static (latched, once), not among
-// the 60 Hz /tf.
-TEST(RealTime, FixedGelTransformsAreStatic) {
+// the 60 Hz /tf. And a real-time contact_sim without simulated time does not advertise a /clock
+// it never publishes.
+TEST(RealTime, FixedGelTransformsAreStaticAndNoSilentClock) {
   ros::NodeHandle nh;
   std::vector<geometry_msgs::TransformStamped> statics;
   std::set<std::string> tf_children;
@@ -143,6 +144,11 @@ TEST(RealTime, FixedGelTransformsAreStatic) {
   EXPECT_EQ(tf_children.count("digit_left_gel"), 0u);
   EXPECT_EQ(tf_children.count("digit_right_gel"), 0u);
 
+  // contact_sim advertised /tf before it would have advertised /clock, and the master knows
+  // every advertised topic at once: no /clock means none is advertised.
+  ros::master::V_TopicInfo topics;
+  ASSERT_TRUE(ros::master::getTopics(topics));
+  for (const ros::master::TopicInfo& topic : topics) EXPECT_NE(topic.name, "/clock");
 }
 
 TEST(RealTime, OpeningTheGripperDropsTheCubeAndBadCommandsChangeNothing) {
