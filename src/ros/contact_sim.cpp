@@ -13,6 +13,7 @@
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "conversions.hpp"
 #include "markers.hpp"
@@ -123,16 +124,20 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   owns_clock_ = use_sim_time;
 
   tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
-  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  // Only the clock's owner advertises /clock: a silent publisher would let a node that waits for
+  // simulated time believe a clock is there.
+  if (owns_clock_) clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
   frame_pub_ = private_nh_.advertise<SimFrame>("frame", 100);
   markers_pub_ = private_nh_.advertise<visualization_msgs::MarkerArray>("markers", 2);
   object_marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);
   joints_pub_ = nh_.advertise<sensor_msgs::JointState>("joint_states", 10);
   episode_pub_ = nh_.advertise<EpisodeInfo>("episode", 1, /*latch=*/true);
+  episode_state_pub_ = nh_.advertise<EpisodeState>("episode_state", 1, /*latch=*/true);
   for (int i = 0; i < 2; ++i) {
     contact_pub_[i] = nh_.advertise<TactileContact>(std::string(kSensorNames[i]) + "/contact", 10);
   }
   startEpisode(params_.seed, params_.height_offset);
+  publishStaticTransforms();
 
   lock_step_ = std::make_unique<LockStep>(
       private_nh_,
@@ -179,6 +184,20 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
 }
 
+void ContactSim::publishStaticTransforms() {
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  for (int i = 0; i < 2; ++i) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = frameStamp();
+    t.header.frame_id = kFingerFrames[i];
+    t.child_frame_id = kGelFrames[i];
+    t.transform = ros_conversions::toTransformMsg(GripperSim::gelInFinger(static_cast<Finger>(i)));
+    transforms.push_back(t);
+  }
+  static_tf_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
+  static_tf_->sendTransform(transforms);
+}
+
 ros::Time ContactSim::frameStamp() const {
   return time_base_ + (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
 }
@@ -216,7 +235,21 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   info.height_offset = start.height_offset_m;
   info.num_shards = 1;
   episode_pub_.publish(info);
+  episode_state_.header = info.header;
+  episode_state_.episode = info.episode;
+  episode_state_.dropped = sim_->dropped();
+  episode_state_pub_.publish(episode_state_);
   return info;
+}
+
+void ContactSim::publishStateChange(const ros::Time& stamp) {
+  if (sim_->dropped() == episode_state_.dropped) return;
+  episode_state_.header.stamp = stamp;
+  episode_state_.dropped = sim_->dropped();
+  episode_state_pub_.publish(episode_state_);
+  if (episode_state_.dropped) {
+    ROS_INFO("contact_sim: episode %u: the object dropped out of the gripper", episode_);
+  }
 }
 
 void ContactSim::applyCommandOrThrow(const GripperCommand& command) {
@@ -410,12 +443,13 @@ std::uint32_t ContactSim::publishFrame() {
   for (int i = 0; i < 2; ++i) {
     const Finger finger = static_cast<Finger>(i);
     transforms.push_back(stamped("gripper_base", kFingerFrames[i], sim_->fingerInBase(finger)));
-    transforms.push_back(stamped(kFingerFrames[i], kGelFrames[i], GripperSim::gelInFinger(finger)));
   }
   transforms.push_back(stamped("world", "object", sim_->objectInWorld()));
   tf2_msgs::TFMessage tf;
   tf.transforms = std::move(transforms);
   tf_pub_.publish(tf);
+
+  publishStateChange(stamp);
 
   sensor_msgs::JointState joints;
   joints.header.stamp = stamp;

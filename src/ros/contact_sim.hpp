@@ -11,9 +11,11 @@
 
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include "lock_step.hpp"
 #include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/EpisodeState.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
@@ -63,7 +65,8 @@ constexpr double kDefaultFriction = 0.5;
 ContactSimParams readContactSimParams(const ros::NodeHandle& private_nh);
 
 /// The contact_sim node's work, shared by the node and the nodelet: owns a GripperSim and
-/// publishes every sensor frame over tf2, /joint_states, /digit_*/contact and /clock.
+/// publishes every sensor frame over tf2, /joint_states, /digit_*/contact and /clock, and the
+/// episode's labels and state on /episode and /episode_state.
 class ContactSim {
  public:
   /// Throws Error (bad parameter, unreadable scene/mesh/material) before advertising anything.
@@ -86,6 +89,10 @@ class ContactSim {
   /// Applies a command; throws Error naming what is wrong (and changes nothing) when invalid.
   void applyCommandOrThrow(const GripperCommand& command);
   EpisodeInfo startEpisode(std::int64_t seed, double height_offset);
+  /// The fixed finger -> gel transforms, once, on /tf_static.
+  void publishStaticTransforms();
+  /// Publishes /episode_state when the episode's state (a drop) differs from the last published.
+  void publishStateChange(const ros::Time& stamp);
   /// Advances one sensor frame of physics and publishes it.
   void advanceFrame();
   /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.
@@ -108,14 +115,18 @@ class ContactSim {
   ros::WallTime tick_;  ///< real time: the scheduled time of the timer tick being handled
   double beta_mm_ = 0.0;
   std::uint32_t episode_ = 0;
+  EpisodeState episode_state_;  ///< as last published on /episode_state
 
   std::mutex mutex_;  // nodelet callbacks may run on several threads
   /// ~reset and ~step's queue: declared before the servers on it, which remove themselves from
   /// it when destroyed (a destroyed queue's mutex made the manager abort at shutdown).
   ros::CallbackQueue service_queue_;
   ros::NodeHandle nh_, private_nh_;
-  ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, frame_pub_, contact_pub_[2];
+  ros::Publisher tf_pub_, clock_pub_, joints_pub_, episode_pub_, episode_state_pub_, frame_pub_,
+      contact_pub_[2];
   ros::Publisher markers_pub_, object_marker_pub_;
+  /// /tf_static (latched); made once everything is valid (it advertises when constructed).
+  std::unique_ptr<tf2_ros::StaticTransformBroadcaster> static_tf_;
   ros::Subscriber command_sub_;
   ros::ServiceServer reset_srv_, step_srv_;
 

@@ -206,7 +206,7 @@ bool DatasetRecorder::write(const std::string& topic,
                " MB free, under ~min_free_mb = " + text(params_.min_free_mb) +
                " MB; recording stopped, the bag is closed with the frames written so far";
       ROS_ERROR("dataset_recorder: %s", error_.c_str());
-      stop_reason_ = "disk_full";
+      stop_reason_ = stop_reason::kDiskFull;
       done_ = true;
       return false;
     }
@@ -218,7 +218,7 @@ bool DatasetRecorder::write(const std::string& topic,
   } catch (const rosbag::BagException& ex) {
     error_ = std::string("writing ") + topic + " to " + bag_paths_.back() + " failed: " + ex.what();
     ROS_ERROR("dataset_recorder: %s; closing the bag", error_.c_str());
-    stop_reason_ = "error";
+    stop_reason_ = stop_reason::kError;
     done_ = true;
     return false;
   }
@@ -251,7 +251,7 @@ void DatasetRecorder::onFramePart(const std::string& topic, const ros::Time& sta
     last_image_stamp_ = std::max(last_image_stamp_, stamp);
     if (params_.samples > 0 && images_ >= static_cast<std::uint64_t>(params_.samples)) {
       target_reached_ = true;
-      if (stop_reason_.empty()) stop_reason_ = "sample_target";
+      if (stop_reason_.empty()) stop_reason_ = stop_reason::kSampleTarget;
     }
     const ros::WallTime now = ros::WallTime::now();
     if ((now - last_progress_).toSec() >= 1.0) {
@@ -307,15 +307,15 @@ void DatasetRecorder::answerFramesWritten() {
   }
   // The source's last frame written: stop (the answer above let the source finish).
   if (!last_frame_stamp_.isZero() && frameComplete(last_frame_stamp_) && !done_) {
-    if (stop_reason_.empty()) stop_reason_ = "last_frame";
+    if (stop_reason_.empty()) stop_reason_ = stop_reason::kLastFrame;
     done_ = true;
   }
 }
 
-void DatasetRecorder::close(const std::string& reason) {
+void DatasetRecorder::close() {
   if (closed_) return;
   closed_ = true;
-  if (stop_reason_.empty()) stop_reason_ = reason;
+  if (stop_reason_.empty()) stop_reason_ = stop_reason::kShutdown;
   try {
     if (bag_) bag_->close();  // writes the index: `rosbag info` reads it
   } catch (const rosbag::BagException& e) {
@@ -336,7 +336,8 @@ void DatasetRecorder::close(const std::string& reason) {
            << "samples_wanted: " << params_.samples << "\n"
            << "stop_reason: " << stop_reason_ << "\n"
            << "complete: "
-           << (error_.empty() && (stop_reason_ == "last_frame" || stop_reason_ == "sample_target")
+           << (error_.empty() && (stop_reason_ == stop_reason::kLastFrame ||
+                                  stop_reason_ == stop_reason::kSampleTarget)
                    ? "true"
                    : "false")
            << "\n";

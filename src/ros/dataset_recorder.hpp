@@ -18,6 +18,18 @@
 
 namespace norm2tex {
 
+/// Why a recording ended: the manifest's `stop_reason` (docs/datasets.md lists these; the docs
+/// check compares that list with this one). Only the first two make a complete dataset.
+namespace stop_reason {
+constexpr const char* kLastFrame = "last_frame";        ///< the source's last frame is written
+constexpr const char* kSampleTarget = "sample_target";  ///< ~samples images are written
+/// Stopped from outside before done: Ctrl-C or SIGTERM (the node), the nodelet unloaded or its
+/// manager stopped, roslaunch ending, the master gone.
+constexpr const char* kShutdown = "shutdown";
+constexpr const char* kError = "error";         ///< a write failed (the manifest says which)
+constexpr const char* kDiskFull = "disk_full";  ///< less than ~min_free_mb free on the output disk
+}  // namespace stop_reason
+
 /// Validated private parameters of dataset_recorder (docs/ros.md, "dataset_recorder").
 struct DatasetRecorderParams {
   std::string output_dir;           ///< ~output_dir: created if missing; must be writable
@@ -56,9 +68,9 @@ class DatasetRecorder {
   /// True once the sample target or the source's last frame is written, or a write failed (the
   /// node then exits).
   bool done() const { return done_; }
-  /// Closes the current bag and writes the manifest; idempotent. `reason` says why it stopped
-  /// when it was not done by itself (e.g. "signal").
-  void close(const std::string& reason = "shutdown");
+  /// Closes the current bag and writes the manifest; idempotent. Stopped before it was done
+  /// (sample target, last frame, a write error), the manifest's stop_reason is `shutdown`.
+  void close();
   /// Non-empty when writing failed (e.g. a full disk): why.
   const std::string& error() const { return error_; }
 

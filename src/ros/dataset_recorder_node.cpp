@@ -24,7 +24,7 @@ int main(int argc, char** argv) {
     while (ros::ok() && !g_stop && !recorder.done()) {
       ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.01));
     }
-    recorder.close(g_stop ? "signal" : "shutdown");
+    recorder.close();
     // Done as planned under roslaunch: end the whole launch as Ctrl-C would, and exit when
     // roslaunch stops this node (a required node's own exit gets a red banner, even status 0).
     if (!g_stop && recorder.error().empty() && norm2tex::endParentLaunch()) {

@@ -64,7 +64,7 @@ class ProbeSimNodelet : public nodelet::Nodelet {
 class DatasetRecorderNodelet : public nodelet::Nodelet {
  public:
   ~DatasetRecorderNodelet() override {
-    if (recorder_) recorder_->close("shutdown");
+    if (recorder_) recorder_->close();
   }
 
  private:

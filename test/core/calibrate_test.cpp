@@ -264,6 +264,37 @@ TEST(Calibration, BadInputIsAClearError) {
   test::expectError([&] { calibrateSensor(m, no_background); }, {"background"});
 }
 
+// A scale the user gives is the scale calibrated, exactly. Presses (contact radii up to 1.8 mm,
+// detected a little wider) of a ball said to have a 1.6 mm radius fit it at 0.054 mm/px only with
+// the detected radii taken as at most ~0.8 of themselves: the radius factor gives way, not the
+// scale (which the fit used to lower silently to where the ball allowed a factor near 1). A ball
+// that cannot make a press at that scale at all refuses the scale, naming the press, its radius
+// in pixels and the ball's radius.
+TEST(Calibration, AGivenScaleIsUsedAsGivenOrRefusedNamingThePress) {
+  const SensorModel m = makeDigitSensorModel();
+  const cv::Mat3b smooth = makeSyntheticBackground(m.imageSize());
+  const DigitShader shader(m, smooth, BackgroundSource::kSynthetic);
+  CalibrationInput input;
+  input.backgrounds.push_back({"bg.png", smooth});
+  int seed = 0;
+  for (const PressCircle& circle : spreadPresses(m, 6)) {
+    input.presses.push_back(
+        {"p" + std::to_string(seed) + ".png", renderPress(m, shader, circle, seed)});
+    ++seed;
+  }
+  input.mm_per_pixel = 0.054;
+  input.ball_diameter_mm = 3.2;
+  const CalibrationResult result = calibrateSensor(m, input);
+  EXPECT_EQ(result.model.mm_per_pixel, 0.054);
+  EXPECT_EQ(result.fit.geometry.mm_per_pixel, 0.054);
+
+  // p4 holds the largest contact (1.8 mm, ~33 px detected a little wider): at 0.6 of it, still
+  // wider than a ball of radius 0.8 mm makes.
+  input.ball_diameter_mm = 1.6;
+  test::expectError([&] { calibrateSensor(m, input); },
+                    {"0.054", "refused", "'p4.png'", " px", "radius 0.8 mm"});
+}
+
 // A labels file made on another machine (test/fixtures/digit_s09/labels_other_machine.csv):
 // header line, CRLF, that machine's absolute paths. It labels the presses given here by their
 // own paths, matched on base names.

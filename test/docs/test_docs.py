@@ -5,6 +5,8 @@
   - every `roslaunch norm2tex X.launch arg:=v` shown names an existing launch file and args it has;
   - every `rosrun norm2tex T` names a program CMakeLists.txt installs;
   - every `norm2tex/XNodelet` named is exported in nodelet_plugins.xml;
+  - every list of the recorder's manifest `stop_reason`s names exactly those the code writes (the
+    constants of src/ros/dataset_recorder.hpp; src/ros writes no other string as one);
   - the parameter tables of docs/ros.md ("private parameter" tables under a node's heading) list
     exactly the private parameters the node's code reads (pnh.param / getParam in src/ros/), and
     the launch-argument tables ("launch arg" tables under a launch file's heading) exactly the
@@ -308,6 +310,30 @@ def compare(what, documented, actual):
     return errors
 
 
+# --- the recorder's stop reasons ----------------------------------------------------------------
+_STOP_LIST = re.compile(r"`stop_reason`\s*\(([^)]*)\)")
+_STOP_LITERAL = re.compile(r'\bstop_reason_\s*=\s*"(\w*)"|\bclose\(\s*"(\w*)"')
+
+
+def code_stop_reasons(ros_dir):
+    """(the manifest's stop reasons: the constants of dataset_recorder.hpp's namespace
+    stop_reason, [string literals written as a stop reason elsewhere in src/ros])."""
+    header = read(os.path.join(ros_dir, "dataset_recorder.hpp"))
+    block = re.search(r"namespace stop_reason \{(.*?)\n\}", header, re.S)
+    reasons = set(re.findall(r'=\s*"(\w+)"', block.group(1))) if block else set()
+    literals = []
+    for f in sorted(os.listdir(ros_dir)):
+        if f.endswith((".cpp", ".hpp")):
+            text = re.sub(r"//.*", "", read(os.path.join(ros_dir, f)))
+            literals += ["src/ros/%s: '%s'" % (f, a or b) for a, b in _STOP_LITERAL.findall(text)]
+    return reasons, literals
+
+
+def documented_stop_reasons(text):
+    """Every list "`stop_reason` (`a`, `b`, ...)" of a page, as sets."""
+    return [set(_ticked(m.group(1))) for m in _STOP_LIST.finditer(text)]
+
+
 # --- the checks over a package ------------------------------------------------------------------
 def check_package(root=ROOT, page_list=None):
     """Every problem found, as one-line messages."""
@@ -338,6 +364,9 @@ def check_package(root=ROOT, page_list=None):
                 errors.append("%s: table of %s: no such launch file" % (where, launch))
                 continue
             errors += compare("%s: %s args" % (where, launch), args, launch_args(launch_path))
+        for listed in documented_stop_reasons(text):
+            reasons, _ = code_stop_reasons(os.path.join(root, "src", "ros"))
+            errors += compare("%s: stop reasons" % where, listed, reasons)
         documented = documented_params(text)
         if documented:
             actual, unowned = code_params(os.path.join(root, "src", "ros"))
@@ -365,6 +394,13 @@ class DocsTest(unittest.TestCase):
     def test_docs_match_the_package(self):
         errors = check_package()
         self.assertEqual(errors, [], "\n" + "\n".join(errors))
+
+    def test_stop_reasons_are_listed_and_only_the_constants_are_written(self):
+        reasons, literals = code_stop_reasons(os.path.join(ROOT, "src", "ros"))
+        self.assertIn("last_frame", reasons)
+        self.assertEqual(literals, [], "write stop reasons through the stop_reason constants")
+        datasets_md = read(os.path.join(ROOT, "docs", "datasets.md"))
+        self.assertEqual(documented_stop_reasons(datasets_md), [reasons])
 
     def test_ros_md_has_every_node_table(self):
         ros_md = read(os.path.join(ROOT, "docs", "ros.md"))
@@ -426,6 +462,12 @@ class CheckerCatchesBrokenPages(unittest.TestCase):
         errors = self.broken(page)
         self.assertTrue(any("'colour' is documented but not in the code" in e for e in errors))
         self.assertTrue(any("'material' is in the code but not documented" in e for e in errors))
+
+    def test_stop_reason_drift(self):
+        errors = self.broken("the manifest's `stop_reason` (`last_frame`, `sample_target`, "
+                             "`signal`, `error`, `disk_full`)\n")
+        self.assertTrue(any("'signal' is documented but not in the code" in e for e in errors))
+        self.assertTrue(any("'shutdown' is in the code but not documented" in e for e in errors))
 
     def test_code_reads_are_found(self):
         src = ('pnh.param<std::string>("a", x, "d");\n  pnh.param("b", y, 1);\n'

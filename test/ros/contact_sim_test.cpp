@@ -4,17 +4,22 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/JointState.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/EpisodeState.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
@@ -98,10 +103,65 @@ TEST(RealTime, TfJointStatesAndContactsPublishWithOneStamp) {
   }
 }
 
+// The gel frames never move on their fingers: they are on /tf_static (latched, once), not among
+// the 60 Hz /tf. And a real-time contact_sim without simulated time does not advertise a /clock
+// it never publishes.
+TEST(RealTime, FixedGelTransformsAreStaticAndNoSilentClock) {
+  ros::NodeHandle nh;
+  std::vector<geometry_msgs::TransformStamped> statics;
+  std::set<std::string> tf_children;
+  int tf_messages = 0;
+  ros::Subscriber static_sub = nh.subscribe<tf2_msgs::TFMessage>(
+      "/tf_static", 10, [&](const auto& m) {
+        statics.insert(statics.end(), m->transforms.begin(), m->transforms.end());
+      });
+  ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const auto& m) {
+    ++tf_messages;
+    for (const auto& t : m->transforms) tf_children.insert(t.child_frame_id);
+  });
+  // Half a second of frames, and the latched static transforms.
+  ASSERT_TRUE(waitFor([&] { return tf_messages >= 30 && statics.size() >= 2; }, 20.0))
+      << tf_messages << " /tf messages, " << statics.size() << " static transforms";
+  EXPECT_EQ(statics.size(), 2u);
+  for (const auto& t : statics) {
+    const bool left = t.child_frame_id == "digit_left_gel";
+    EXPECT_TRUE(left || t.child_frame_id == "digit_right_gel") << t.child_frame_id;
+    EXPECT_EQ(t.header.frame_id, left ? "finger_left" : "finger_right");
+    const Eigen::Isometry3d expected = norm2tex::GripperSim::gelInFinger(
+        left ? norm2tex::Finger::kLeft : norm2tex::Finger::kRight);
+    EXPECT_NEAR(t.transform.translation.x, expected.translation().x(), 1e-9);
+    EXPECT_NEAR(t.transform.translation.y, expected.translation().y(), 1e-9);
+    EXPECT_NEAR(t.transform.translation.z, expected.translation().z(), 1e-9);
+    const Eigen::Quaterniond q(expected.linear());
+    EXPECT_NEAR(std::abs(t.transform.rotation.w * q.w() + t.transform.rotation.x * q.x() +
+                         t.transform.rotation.y * q.y() + t.transform.rotation.z * q.z()),
+                1.0, 1e-9)
+        << t.child_frame_id;
+  }
+  for (const char* moving : {"gripper_base", "finger_left", "finger_right", "object"}) {
+    EXPECT_EQ(tf_children.count(moving), 1u) << moving << " is not on /tf";
+  }
+  EXPECT_EQ(tf_children.count("digit_left_gel"), 0u);
+  EXPECT_EQ(tf_children.count("digit_right_gel"), 0u);
+
+  // contact_sim advertised /tf before it would have advertised /clock, and the master knows
+  // every advertised topic at once: no /clock means none is advertised.
+  ros::master::V_TopicInfo topics;
+  ASSERT_TRUE(ros::master::getTopics(topics));
+  for (const ros::master::TopicInfo& topic : topics) EXPECT_NE(topic.name, "/clock");
+}
+
 TEST(RealTime, OpeningTheGripperDropsTheCubeAndBadCommandsChangeNothing) {
   Listener l;
+  norm2tex::EpisodeState::ConstPtr state;
+  ros::Subscriber state_sub = l.nh.subscribe<norm2tex::EpisodeState>(
+      "/episode_state", 10, [&](const auto& m) { state = m; });
   ros::Publisher command = l.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 10, true);
   ASSERT_TRUE(waitFor([&] { return l.joints && command.getNumSubscribers() > 0; }, 20.0));
+  // Latched: the episode's state reaches a late subscriber. Held, not dropped.
+  ASSERT_TRUE(waitFor([&] { return state && l.episode; }, 20.0));
+  EXPECT_FALSE(state->dropped);
+  EXPECT_EQ(state->episode, l.episode->episode);
   const double held = l.joints->position[0];
   norm2tex::GripperCommand bad;
   bad.mode = norm2tex::GripperCommand::ABSOLUTE;
@@ -125,6 +185,10 @@ TEST(RealTime, OpeningTheGripperDropsTheCubeAndBadCommandsChangeNothing) {
       waitFor([&] { return !l.contacts[0]->in_contact && !l.contacts[1]->in_contact; }, 20.0))
       << "the cube never left the gels";
   EXPECT_TRUE(waitFor([&] { return l.joints->position[0] > 0.0199; }, 20.0));
+  // Real time has no ~step to return `dropped`: /episode_state says it, stamped with the frame.
+  EXPECT_TRUE(waitFor([&] { return state->dropped; }, 20.0)) << "/episode_state never said dropped";
+  EXPECT_EQ(state->episode, l.episode->episode);
+  EXPECT_GT(state->header.stamp, l.episode->header.stamp);
 }
 
 TEST(BadInput, StartUpErrorsExitNonZeroNamingTheCause) {

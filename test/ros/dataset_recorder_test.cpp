@@ -111,6 +111,12 @@ TEST(DatasetRecorder, RecordsEveryLockStepFrameAndCtrlCLeavesAValidBag) {
   for (const char* topic : {"/digit_left/image_raw", "/digit_right/image_raw"}) {
     EXPECT_EQ(interrupted.image_stamps.at(topic), stamps) << topic;
   }
+  // Stopped from outside: the reason docs/datasets.md gives for it, and not complete.
+  const std::string interrupted_manifest = readFile(sigint_dir + "/norm2tex_shard0.yaml");
+  EXPECT_NE(interrupted_manifest.find("stop_reason: shutdown\n"), std::string::npos)
+      << interrupted_manifest;
+  EXPECT_NE(interrupted_manifest.find("complete: false\n"), std::string::npos)
+      << interrupted_manifest;
 
   // The main recorder's target was 20 images = these 10 frames: it closed by itself.
   ASSERT_TRUE(
@@ -126,6 +132,7 @@ TEST(DatasetRecorder, RecordsEveryLockStepFrameAndCtrlCLeavesAValidBag) {
   const std::string manifest = readFile(main_dir + "/norm2tex_shard0.yaml");
   EXPECT_NE(manifest.find("images: 20"), std::string::npos) << manifest;
   EXPECT_NE(manifest.find("complete: true"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("stop_reason: sample_target\n"), std::string::npos) << manifest;
   EXPECT_NE(manifest.find("'wood/variant0': 20"), std::string::npos) << manifest;
   EXPECT_NE(manifest.find("'/digit_left/depth': {received: 10, written: 10}"), std::string::npos)
       << manifest;

@@ -26,7 +26,9 @@ struct CalibrationInput {
   /// Optional contact circles, one per press (nullopt: detect it); empty = detect all.
   std::vector<std::optional<PressCircle>> labels;
   double ball_diameter_mm = 0.0;
-  std::optional<double> mm_per_pixel;  ///< fitted when not given
+  /// Fitted when not given; a given one is the calibrated scale exactly, or refused (Error naming
+  /// the press the ball cannot make at it), never changed.
+  std::optional<double> mm_per_pixel;
 };
 
 struct CalibrationOptions {

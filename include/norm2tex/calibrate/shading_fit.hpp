@@ -83,7 +83,9 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
 /// `mm_per_pixel` is not given, and the rim-shadow width; each chosen as the one whose fit explains
 /// the most variance (a coarse grid, then a local pattern search). Throws Error when no scale in
 /// the searched range (kMinSearchedScale-kMaxSearchedScale mm/px at QVGA, halved at VGA) fits the
-/// ball.
+/// ball. A given `mm_per_pixel` is the geometry's scale, exactly: the radius factor is limited to
+/// what the ball can make at it, and when even the smallest factor (0.6) makes a press wider than
+/// the ball, it throws Error naming that press, its radius in pixels and the ball's radius.
 /// When the scale is searched and there are more than 16 presses, the search runs on 16 of
 /// them spread evenly over the set, and the response is then fitted on all.
 /// With `start`, the coarse grid is skipped and the local search starts there (a refit);

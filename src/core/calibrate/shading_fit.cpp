@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -236,9 +237,11 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  double ball_radius_mm, std::optional<double> mm_per_pixel,
                                  std::optional<PressGeometry> start) {
   if (presses.empty()) throw Error("fitShadingAndGeometry: no presses");
-  double largest_radius_px = 0.0;
-  for (const PressObservation& p : presses)
-    largest_radius_px = std::max(largest_radius_px, p.circle.radius_px);
+  const PressObservation* largest = &presses.front();
+  for (const PressObservation& p : presses) {
+    if (p.circle.radius_px > largest->circle.radius_px) largest = &p;
+  }
+  const double largest_radius_px = largest->circle.radius_px;
   const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
   const double scale_lo = kMinSearchedScale * qvga, scale_hi = kMaxSearchedScale * qvga;
   const double factor_lo = 0.6, factor_hi = 1.3;
@@ -246,12 +249,21 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   const auto feasibleScale = [&](double factor) {
     return 0.97 * ball_radius_mm / (factor * largest_radius_px);
   };
-  if (mm_per_pixel && *mm_per_pixel > feasibleScale(factor_lo)) {
+  // Largest radius factor at which every contact still fits the ball at a given scale.
+  const auto feasibleFactor = [&](double scale) {
+    return 0.97 * ball_radius_mm / (scale * largest_radius_px);
+  };
+  // A given scale is used as given, never changed: the radius factor is held to what the ball
+  // can make at it, and where not even the smallest factor fits, the scale is refused.
+  if (mm_per_pixel && feasibleFactor(*mm_per_pixel) < factor_lo) {
     std::ostringstream message;
-    message << "the largest press (contact radius " << largest_radius_px
-            << " px = " << largest_radius_px * *mm_per_pixel << " mm at " << *mm_per_pixel
-            << " mm/px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
-            << " mm can make; check --ball-diameter-mm and --mm-per-pixel";
+    message << std::setprecision(4) << "mm per pixel " << *mm_per_pixel << " refused: press '"
+            << largest->name << "' has a contact circle of radius " << largest_radius_px << " px, "
+            << largest_radius_px * *mm_per_pixel << " mm at that scale; even " << factor_lo
+            << " of it (the least the fit takes a detected radius to be) is wider than a ball of "
+            << "radius " << ball_radius_mm << " mm (diameter " << 2.0 * ball_radius_mm
+            << " mm) can make; check --ball-diameter-mm and --mm-per-pixel (or leave the scale "
+            << "out to fit it)";
     throw Error(message.str());
   }
   if (!mm_per_pixel && feasibleScale(factor_lo) < scale_lo) {
@@ -278,11 +290,17 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   const std::vector<PressObservation>& search = use_subset ? subset : presses;
   SensorModel model = base;
   // The fit at `g` (clamped to the searched ranges), or nothing where the ball cannot make it.
+  // With a given scale the factor gives way to the ball, never the scale.
   const auto fitAt = [&](PressGeometry g, double sigma) -> std::optional<ShadingFit> {
-    g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
-    if (mm_per_pixel) g.mm_per_pixel = *mm_per_pixel;
-    g.mm_per_pixel =
-        std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
+    if (mm_per_pixel) {
+      g.mm_per_pixel = *mm_per_pixel;
+      g.radius_factor = std::clamp(g.radius_factor, factor_lo,
+                                   std::min(factor_hi, feasibleFactor(*mm_per_pixel)));
+    } else {
+      g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
+      g.mm_per_pixel =
+          std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
+    }
     if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) {
       return std::nullopt;
     }
@@ -303,7 +321,11 @@ ShadingFit fitShadingAndGeometry(const SensorModel& base,
   const double scale_ratio = std::pow(scale_hi / scale_lo, 1.0 / (kScaleSteps - 1));
   std::vector<ScaleProfilePoint> profile(kScaleSteps);
   if (start) tryGeometry(*start, default_sigma);
-  for (double factor = factor_lo; !start && factor <= factor_hi + 1e-9; factor += 0.1) {
+  // With a given scale, the grid's factors above the ball's limit are all clamped to it: the
+  // first of them is tried, the rest not.
+  const double factor_top =
+      mm_per_pixel ? std::min(factor_hi, feasibleFactor(*mm_per_pixel)) : factor_hi;
+  for (double factor = factor_lo; !start && factor <= factor_top + 0.1 - 1e-9; factor += 0.1) {
     const double top = std::min(scale_hi, feasibleScale(factor));
     for (int i = 0; i < (mm_per_pixel ? 1 : kScaleSteps); ++i) {
       const double scale = scale_lo * std::pow(scale_ratio, i);
