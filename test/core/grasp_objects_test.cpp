@@ -281,8 +281,8 @@ TEST_P(GraspObjectTest, HoldsStillForTenSecondsWithBothGelsAlike) {
   EXPECT_NEAR(left.normal_force_n, right.normal_force_n,
               0.1 * std::max(left.normal_force_n, right.normal_force_n));
   // The grip the episode asked for: 1 mm into each gel, the law's force. (A decomposition's
-  // parts are HACD's approximation of the mesh: the ridged plate settles 1.2 degrees tilted
-  // in the grip, its deepest corner 1.33 mm in.)
+  // parts are HACD's approximation of the mesh: the ridged plate settles about 1 degree tilted
+  // in the grip, its deepest corner 1.28 mm in.)
   const double tolerance = sim.collision().kind == "decomposition" ? 0.4e-3 : 0.1e-3;
   for (const GelContactState* c : {&left, &right}) {
     EXPECT_NEAR(c->penetration_m, 1e-3, tolerance);
