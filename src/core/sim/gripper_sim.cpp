@@ -465,6 +465,7 @@ void GripperSim::updateGelContacts() {
   for (int i = 0; i < 2; ++i) {
     const btRigidBody& gel = *world_->gels[i];
     const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
+    const Eigen::Isometry3d world_in_gel = gel_in_world.inverse();
     const Eigen::Vector3d normal_on_object = -gel_in_world.linear().col(2);  // into the gel
     // The last step's measurement still holds unless the finger has moved since (the object
     // has not: nothing moves it between a step and the next tick's contacts).
@@ -477,7 +478,7 @@ void GripperSim::updateGelContacts() {
       manifold.refreshContactPoints(gel.getWorldTransform(), object.getWorldTransform());
       for (int c = manifold.getNumContacts() - 1; c >= 0; --c) {
         const Eigen::Vector3d on_object =
-            gel_in_world.inverse() * toEigen(manifold.getContactPoint(c).m_positionWorldOnB);
+            world_in_gel * toEigen(manifold.getContactPoint(c).m_positionWorldOnB);
         // (Points the pad's edge clipped lie on it: a kept anchor there may move past it by
         // as much as it may slide, or every held object would lose its anchors there.)
         if (std::abs(on_object.x()) > half_w + kContactBreakingM ||
