@@ -238,14 +238,28 @@ EpisodeInfo ContactSim::startEpisode(std::int64_t seed, double height_offset) {
   episode_state_.header = info.header;
   episode_state_.episode = info.episode;
   episode_state_.dropped = sim_->dropped();
+  episode_state_.too_deep = tooDeep();
   episode_state_pub_.publish(episode_state_);
   return info;
 }
 
+bool ContactSim::tooDeep() const {
+  return sim_->contact(Finger::kLeft).too_deep || sim_->contact(Finger::kRight).too_deep;
+}
+
 void ContactSim::publishStateChange(const ros::Time& stamp) {
-  if (sim_->dropped() == episode_state_.dropped) return;
+  const bool too_deep = episode_state_.too_deep || tooDeep();  // latched for the episode
+  if (sim_->dropped() == episode_state_.dropped && too_deep == episode_state_.too_deep) return;
+  if (too_deep && !episode_state_.too_deep) {
+    const double deepest = std::max(sim_->contact(Finger::kLeft).penetration_m,
+                                    sim_->contact(Finger::kRight).penetration_m);
+    ROS_WARN("contact_sim: episode %u: the object is %.2f mm into a gel, deeper than the gel "
+             "law's table reaches (%.2f mm): its forces are extrapolated",
+             episode_, deepest * 1e3, sim_->config().gel_law.points().back().first * 1e3);
+  }
   episode_state_.header.stamp = stamp;
   episode_state_.dropped = sim_->dropped();
+  episode_state_.too_deep = too_deep;
   episode_state_pub_.publish(episode_state_);
   if (episode_state_.dropped) {
     ROS_INFO("contact_sim: episode %u: the object dropped out of the gripper", episode_);
@@ -459,13 +473,6 @@ std::uint32_t ContactSim::publishFrame() {
 
   for (int i = 0; i < 2; ++i) {
     const GelContactState& state = sim_->contact(static_cast<Finger>(i));
-    if (state.too_deep) {
-      ROS_WARN_THROTTLE(1.0,
-                        "contact_sim: the object is %.2f mm into %s's gel, deeper than the gel "
-                        "law's table reaches (%.2f mm): its force is extrapolated",
-                        state.penetration_m * 1e3, kSensorNames[i],
-                        sim_->config().gel_law.points().back().first * 1e3);
-    }
     // The patch costs a rasterization: skip it when nobody listens.
     if (contact_pub_[i].getNumSubscribers() == 0) continue;
     std_msgs::Header header;

@@ -93,6 +93,8 @@ class ContactSim {
   void publishStaticTransforms();
   /// Publishes /episode_state when the episode's state (a drop) differs from the last published.
   void publishStateChange(const ros::Time& stamp);
+  /// Either gel holds the object deeper than the gel law's table reaches.
+  bool tooDeep() const;
   /// Advances one sensor frame of physics and publishes it.
   void advanceFrame();
   /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.

@@ -15,6 +15,8 @@
 #include <opencv2/core.hpp>
 
 #include "norm2tex/EpisodeInfo.h"
+#include "norm2tex/EpisodeState.h"
+#include "norm2tex/GripperCommand.h"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
@@ -158,6 +160,27 @@ TEST(OwnMesh, AUsersCylinderIsHeldStillAtEveryOffsetOfTheScene) {
       EXPECT_FALSE(c->too_deep);
     }
   }
+  // Squeezed to the gripper's force limit (35 N, 2.03 mm): deeper than the gel law's table
+  // (2 mm), which the contact says at the frame and the episode's state keeps.
+  norm2tex::EpisodeState::ConstPtr state;
+  ros::Subscriber state_sub = nh.subscribe<norm2tex::EpisodeState>(
+      "/episode_state", 10, [&](const auto& m) { state = m; });
+  ros::Publisher command = nh.advertise<norm2tex::GripperCommand>("/gripper/command", 1);
+  ASSERT_TRUE(waitFor([&] { return command.getNumSubscribers() > 0 && state; }, 10.0));
+  EXPECT_FALSE(state->too_deep);
+  norm2tex::GripperCommand squeeze;
+  squeeze.mode = norm2tex::GripperCommand::ABSOLUTE;
+  squeeze.opening = 0.0;
+  command.publish(squeeze);
+  ros::Time t;
+  for (int i = 0; i < 20 && !(state && state->too_deep); ++i) {
+    t = frame(6);
+    waitFor([&] { return state && state->header.stamp == t; }, 1.0);  // changed at this frame?
+  }
+  ASSERT_TRUE(state && state->too_deep) << "/episode_state never said too_deep";
+  ASSERT_TRUE(waitFor([&] { return contact["digit_left"].count(t) > 0; }, 10.0));
+  EXPECT_TRUE(contact["digit_left"][t]->too_deep);
+  EXPECT_GT(contact["digit_left"][t]->max_indentation, 2e-3);
   std::string mesh;
   if (nh.getParam("/own_mesh_test/mesh", mesh)) std::remove(mesh.c_str());
 }
