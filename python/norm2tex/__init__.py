@@ -1,0 +1,68 @@
+"""norm2tex from Python: DIGIT tactile images with Norm2Tex texture, without ROS.
+
+The compiled core (``norm2tex._core``) is imported on first use, so that
+``from norm2tex.msg import TactileContact`` (catkin's generated messages, which share this
+package) costs nothing extra and works where the module was not built.
+
+Units: metres for poses and positions, millimetres where a name ends in ``_mm``, newtons for
+forces. Poses are 4x4 homogeneous matrices (numpy float64) or ``(xyz, quaternion_xyzw)`` pairs;
+poses returned are 4x4 matrices. Images are numpy arrays: bgr8 ``(320, 240, 3) uint8`` as the
+DIGIT publishes them, depth ``(320, 240) float32`` in metres, masks ``(320, 240) uint8``.
+
+    import norm2tex
+    sensor = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    renderer = norm2tex.TactileRenderer(sensor)
+    ...
+
+Environments for learning (Gymnasium API): ``norm2tex.envs``.
+"""
+
+import importlib as _importlib
+
+from norm2tex._paths import config_dir, config_path, material_config, scene_config  # noqa: F401
+
+# What the compiled core exports (help(norm2tex.<name>) for each).
+_CORE_NAMES = (
+    "Error",
+    "SensorModel",
+    "TexturedMesh",
+    "load_object_mesh",
+    "HeightAtlas",
+    "bake_normal_map",
+    "load_texture",
+    "material_names",
+    "MaterialConfig",
+    "material_texture",
+    "RenderedFrame",
+    "TactileRenderer",
+    "GripperOptions",
+    "ObjectOptions",
+    "PhysicsOptions",
+    "EpisodeOptions",
+    "SceneConfig",
+    "GripperSim",
+    "TactileGripperOptions",
+    "TactileGripperBatch",
+)
+
+__all__ = list(_CORE_NAMES) + ["config_dir", "config_path", "material_config", "scene_config"]
+
+
+def __getattr__(name):
+    """Imports the compiled core when one of its names is first asked for (PEP 562)."""
+    if name in _CORE_NAMES or name == "_core":
+        try:
+            # import_module, not "from norm2tex import _core": that asks this very __getattr__.
+            _core = _importlib.import_module("norm2tex._core")
+        except ImportError as error:
+            raise ImportError(
+                "norm2tex's compiled module (norm2tex._core) could not be imported: %s. It is "
+                "built with the package when pybind11 is installed (Debian: pybind11-dev); "
+                "source the workspace's setup.bash first." % error
+            ) from error
+        return _core if name == "_core" else getattr(_core, name)
+    raise AttributeError("module 'norm2tex' has no attribute %r" % name)
+
+
+def __dir__():
+    return sorted(list(globals().keys()) + list(_CORE_NAMES))

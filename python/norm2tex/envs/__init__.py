@@ -1,0 +1,1 @@
+from norm2tex.envs.spaces import Box, Dict, Discrete  # noqa: F401

@@ -1,0 +1,106 @@
+"""The in-process backend: N simulated grippers with both DIGITs in this process
+(norm2tex._core.TactileGripperBatch), stepped on C++ threads with the GIL released."""
+
+import math
+
+import numpy as np
+
+import norm2tex
+
+# Command modes of a backend step (TactileGripperBatch's).
+KEEP, ABSOLUTE, DELTA = 0, 1, 2
+
+
+class InProcessBackend:
+    """What an environment needs from a simulator, for `count` grippers.
+
+    Every backend has this interface (RosBackend too, for count 1):
+      size, frame_seconds, variant_count
+      reset(i, seed, height_offset_m=None, variant=None) -> dict(episode, seed, height_offset_m,
+                                                                   grasp_opening)
+      set_noise_seed(i, noise_seed)
+      step(modes, values, frames=1)      # per gripper: KEEP / ABSOLUTE / DELTA and a value
+      images(finger) -> (N, rows, cols, 3) uint8     finger: "left" / "right"
+      depths(finger) -> (N, rows, cols) float32 m
+      background(finger) -> (rows, cols, 3) uint8    (no contact, no noise)
+      state() -> dict of arrays: opening, commanded_opening (N,), normal_force_n,
+                 penetration_m, in_contact (N, 2), dropped (N,), frame (N,)
+      height_offset_range -> (low, high) m
+      close()
+
+    Parameters are contact_sim's and tactile_renderer's (same names, same defaults), so the same
+    choices give the same frames as gripper_sim.launch.
+    """
+
+    def __init__(
+        self,
+        count=1,
+        scene="cube",
+        sensor=None,
+        material="wood",
+        variant=0,
+        beta_mm=None,
+        friction=None,
+        seed=0,
+        noise_seed=0,
+        noise_per_episode=True,
+        material_seed=0,
+        frame_rate_hz=60.0,
+        physics_rate_hz=1000.0,
+        threads=0,
+    ):
+        sensor_model = norm2tex.SensorModel.load(sensor or norm2tex.config_path("digit.yaml"))
+        scene_config = norm2tex.SceneConfig.load(norm2tex.scene_config(scene))
+        options = []
+        material_path = norm2tex.material_config(material) if material else ""
+        self.variant_count = (
+            norm2tex.MaterialConfig.load(material_path).variant_count if material_path else 1
+        )
+        for _ in range(count):
+            o = norm2tex.TactileGripperOptions()
+            o.material_config = material_path
+            o.variant = int(variant)
+            o.material_seed = int(material_seed)
+            o.beta_mm = -1.0 if beta_mm is None else float(beta_mm)
+            o.friction = -1.0 if friction is None else float(friction)
+            o.seed = int(seed)
+            o.noise_seed = -1 if noise_seed is None else int(noise_seed)
+            o.noise_per_episode = bool(noise_per_episode)
+            o.frame_rate_hz = float(frame_rate_hz)
+            o.physics_rate_hz = float(physics_rate_hz)
+            options.append(o)
+        self.batch = norm2tex.TactileGripperBatch(scene_config, sensor_model, options, threads)
+        self.size = count
+        self.frame_seconds = self.batch.frame_seconds
+        self.height_offset_range = self.batch.sim(0).height_offset_range
+        self.beta_mm = self.batch.beta_mm(0)
+        self.friction = self.batch.friction(0)
+        self._backgrounds = {f: self.batch.background(f) for f in ("left", "right")}
+
+    def reset(self, i, seed, height_offset_m=None, variant=None):
+        offset = None if height_offset_m is None or math.isnan(height_offset_m) else height_offset_m
+        return self.batch.reset(i, int(seed), offset, -1 if variant is None else int(variant))
+
+    def prefetch_variant(self, variant):
+        self.batch.prefetch_variant(int(variant))
+
+    def set_noise_seed(self, i, noise_seed):
+        self.batch.set_noise_seed(i, -1 if noise_seed is None else int(noise_seed))
+
+    def step(self, modes, values, frames=1):
+        self.batch.step(list(modes), [float(v) for v in values], int(frames))
+
+    def images(self, finger):
+        return self.batch.images(finger)
+
+    def depths(self, finger):
+        return self.batch.depths(finger)
+
+    def background(self, finger):
+        return self._backgrounds[finger]
+
+    def state(self):
+        return self.batch.state()
+
+    def close(self):
+        self.batch = None

@@ -1,0 +1,283 @@
+// Bindings of the renderer's side: sensor model, meshes, textures, materials, TactileRenderer.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/materials/procedural_material.hpp"
+#include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/render/tactile_renderer.hpp"
+#include "norm2tex/texture/height_atlas_baker.hpp"
+#include "norm2tex/texture/normal_map.hpp"
+#include "numpy_conversions.hpp"
+
+namespace norm2tex {
+namespace python {
+namespace {
+
+using Release = py::call_guard<py::gil_scoped_release>;
+
+/// One rendered frame, copied out of the renderer's reused buffers.
+struct RenderedFrame {
+  py::array image;         // (rows, cols, 3) uint8, bgr8
+  py::array depth;         // (rows, cols) float32, metres
+  py::array contact_mask;  // (rows, cols) uint8, 255 in contact
+  bool textured = false;
+};
+
+RenderedFrame copyFrame(const TactileFrame& frame) {
+  RenderedFrame out;
+  out.image = toNumpy(frame.image);
+  out.depth = toNumpy(frame.depthMetres());
+  out.contact_mask = toNumpy(frame.contact_mask);
+  out.textured = frame.textured;
+  return out;
+}
+
+py::array_t<float> vectorsToNumpy(const std::vector<Eigen::Vector3f>& v) {
+  py::array_t<float> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int k = 0; k < 3; ++k) a(i, k) = v[i][k];
+  return out;
+}
+
+/// A texture for `mesh` (a copy: unwrapped when it has no UVs): atlas, the mesh it is for, and
+/// the beta it comes with.
+py::tuple textureFor(const TextureSource& source, const TexturedMesh& mesh) {
+  auto copy = std::make_shared<TexturedMesh>(mesh);
+  ObjectTexture texture;
+  {
+    py::gil_scoped_release release;
+    texture = loadObjectTexture(source, *copy);
+  }
+  return py::make_tuple(std::const_pointer_cast<HeightAtlas>(texture.atlas), copy,
+                        texture.beta_mm, texture.description);
+}
+
+}  // namespace
+
+void bindRender(py::module_& m) {
+  py::class_<SensorModel>(m, "SensorModel",
+                          "Everything about one DIGIT that the renderer needs (config/digit.yaml). "
+                          "Gel frame: origin at the centre of the undeformed gel surface, +x image "
+                          "right, +y image down, +z out of the gel towards the object.")
+      .def(py::init([](bool vga) { return makeDigitSensorModel(vga); }), py::arg("vga") = false,
+           "The default DIGIT at QVGA (320 x 240), or VGA (640 x 480) with vga=True.")
+      .def_static("load", &loadSensorModel, py::arg("yaml_path"),
+                  "Loads a sensor yaml (config/digit.yaml); raises norm2tex.Error naming the "
+                  "file and key at fault.")
+      .def("save", [](const SensorModel& s, const std::string& path) { saveSensorModel(s, path); },
+           py::arg("yaml_path"), "Writes the model as a sensor yaml that load() reads back.")
+      .def_readwrite("rows", &SensorModel::rows, "image height, pixels")
+      .def_readwrite("cols", &SensorModel::cols, "image width, pixels")
+      .def_readwrite("mm_per_pixel", &SensorModel::mm_per_pixel, "gel mm per pixel at the gel")
+      .def_readwrite("gel_thickness_mm", &SensorModel::gel_thickness_mm, "indentation limit, mm")
+      .def_readwrite("gel_pad_width_mm", &SensorModel::gel_pad_width_mm, "physical pad, mm")
+      .def_readwrite("gel_pad_height_mm", &SensorModel::gel_pad_height_mm, "physical pad, mm")
+      .def_readwrite("background_image", &SensorModel::background_image,
+                     "no-contact frame (bgr image file); empty: the synthetic background")
+      .def("validate", [](const SensorModel& s) { validate(s); },
+           "Raises norm2tex.Error naming the first field out of range.")
+      .def("__repr__", [](const SensorModel& s) {
+        return "<SensorModel " + std::to_string(s.rows) + "x" + std::to_string(s.cols) + ", " +
+               std::to_string(s.mm_per_pixel) + " mm/px>";
+      });
+
+  py::class_<TexturedMesh, std::shared_ptr<TexturedMesh>>(
+      m, "TexturedMesh", "A triangle mesh with optional UVs, in metres (the object frame).")
+      .def(py::init([](py::array_t<float, py::array::c_style | py::array::forcecast> vertices,
+                       py::array_t<int, py::array::c_style | py::array::forcecast> triangles) {
+             if (vertices.ndim() != 2 || vertices.shape(1) != 3 || triangles.ndim() != 2 ||
+                 triangles.shape(1) != 3) {
+               throw py::value_error("vertices must be (N, 3) and triangles (M, 3)");
+             }
+             std::vector<Eigen::Vector3f> v(vertices.shape(0));
+             std::vector<Eigen::Vector3i> t(triangles.shape(0));
+             for (py::ssize_t i = 0; i < vertices.shape(0); ++i)
+               v[i] = {vertices.at(i, 0), vertices.at(i, 1), vertices.at(i, 2)};
+             for (py::ssize_t i = 0; i < triangles.shape(0); ++i)
+               t[i] = {triangles.at(i, 0), triangles.at(i, 1), triangles.at(i, 2)};
+             return std::make_shared<TexturedMesh>(std::move(v), std::move(t));
+           }),
+           py::arg("vertices"), py::arg("triangles"),
+           "A mesh from (N, 3) vertices in metres and (M, 3) vertex indices, wound outwards; "
+           "no UVs (a material unwraps it).")
+      .def_property_readonly("vertices",
+                             [](const TexturedMesh& mesh) { return vectorsToNumpy(mesh.vertices()); },
+                             "(N, 3) float32, metres")
+      .def_property_readonly("triangles",
+                             [](const TexturedMesh& mesh) {
+                               py::array_t<int> out({static_cast<py::ssize_t>(mesh.triangles().size()),
+                                                     py::ssize_t{3}});
+                               auto a = out.mutable_unchecked<2>();
+                               for (std::size_t i = 0; i < mesh.triangles().size(); ++i)
+                                 for (int k = 0; k < 3; ++k) a(i, k) = mesh.triangles()[i][k];
+                               return out;
+                             },
+                             "(M, 3) int32 vertex indices")
+      .def_property_readonly("has_uvs", &TexturedMesh::hasUvs)
+      .def_property_readonly("bounds",
+                             [](const TexturedMesh& mesh) {
+                               const Eigen::Vector3d lo = mesh.bounds().min().cast<double>();
+                               const Eigen::Vector3d hi = mesh.bounds().max().cast<double>();
+                               return py::make_tuple(lo, hi);
+                             },
+                             "(min xyz, max xyz), metres");
+
+  m.def(
+      "load_object_mesh",
+      [](const std::string& spec, double scale) {
+        ObjectMesh object;
+        {
+          py::gil_scoped_release release;
+          object = loadObjectMesh(spec, scale);
+        }
+        py::dict out;
+        out["mesh"] = std::make_shared<TexturedMesh>(std::move(object.mesh));
+        out["shape"] = std::string(shapeName(object.shape));
+        out["radius_m"] = object.radius_m;
+        out["half_length_m"] = object.half_length_m;
+        out["axis"] = object.axis;
+        return out;
+      },
+      py::arg("spec"), py::arg("scale") = 1.0,
+      "Loads an object: a mesh file (OBJ, STL, PLY, DAE, glTF/GLB; `scale` converts its units to "
+      "metres) or a primitive in millimetres, 'box:<x>x<y>x<z>' or 'sphere:<r>'. Returns a dict: "
+      "mesh (TexturedMesh), shape ('mesh', 'box', 'sphere', 'cylinder', 'capsule'), radius_m, "
+      "half_length_m, axis. Raises norm2tex.Error naming the file.");
+
+  py::class_<HeightAtlas, std::shared_ptr<HeightAtlas>>(
+      m, "HeightAtlas",
+      "H_global: the baked height map of a texture over the UV square, with its validity mask. "
+      "Row 0 is v = 1 (OpenGL/glTF UVs). Heights are normalised (a material: [-1, 1]) or, at "
+      "physical scale, millimetres.")
+      .def(py::init([](const py::array& heights, const py::array& valid) {
+             cv::Mat1f h = fromNumpy(heights, CV_32FC1, "heights");
+             cv::Mat1b v = valid.is_none() ? cv::Mat1b(h.size(), 255)
+                                           : cv::Mat1b(fromNumpy(valid, CV_8UC1, "valid"));
+             return std::make_shared<HeightAtlas>(h, v);
+           }),
+           py::arg("heights"), py::arg("valid") = py::none(),
+           "From (rows, cols) float32 heights and an optional uint8 mask (non-zero = valid; "
+           "NaN heights are invalid). Copies both.")
+      .def_property_readonly("heights", [](const HeightAtlas& a) { return toNumpy(a.heights()); },
+                             "(rows, cols) float32 (0 where invalid)")
+      .def_property_readonly("valid", [](const HeightAtlas& a) { return toNumpy(a.valid()); },
+                             "(rows, cols) uint8, 255 where valid")
+      .def_property_readonly("shape", [](const HeightAtlas& a) { return py::make_tuple(a.rows(), a.cols()); })
+      .def_property_readonly("island_count", &HeightAtlas::islandCount)
+      .def("sample", [](const HeightAtlas& a, double u, double v) { return a.sample(u, v); },
+           py::arg("u"), py::arg("v"), "H_global at (u, v), bilinear within a UV island; 0 if invalid.");
+
+  m.def(
+      "bake_normal_map",
+      [](const std::string& path, const std::string& convention, double mm_per_texel) {
+        NormalMapOptions map_options;
+        map_options.convention = parseNormalConvention(convention);
+        BakeOptions options;
+        options.mm_per_texel = mm_per_texel;
+        py::gil_scoped_release release;
+        return std::make_shared<HeightAtlas>(
+            bakeHeightAtlas(NormalMap::load(path, map_options), options));
+      },
+      py::arg("path"), py::arg("convention") = "opengl", py::arg("mm_per_texel") = 0.0,
+      "Integrates a UV normal map (PNG/JPEG/TIFF; convention 'opengl' (+Y up) or 'directx') "
+      "into H_global, as norm2tex_bake does (no disk cache). mm_per_texel > 0 sets the relief "
+      "filter's scale in mm; 0 uses its texel default.");
+
+  m.def(
+      "load_texture",
+      [](const TexturedMesh& mesh, const std::string& normal_map, const std::string& atlas,
+         const std::string& convention) {
+        TextureSource source;
+        source.normal_map = normal_map;
+        source.atlas = atlas;
+        source.convention = parseNormalConvention(convention);
+        return textureFor(source, mesh);
+      },
+      py::arg("mesh"), py::arg("normal_map") = "", py::arg("atlas") = "",
+      py::arg("convention") = "opengl",
+      "The texture the ROS renderer would use for `mesh`: a normal map (baked through the disk "
+      "cache), a baked atlas (float TIFF), or with neither the mesh's own normal texture. "
+      "Returns (HeightAtlas or None, TexturedMesh it is for, beta_mm it comes with (0: none), "
+      "description).");
+
+  m.def("material_names", &materialNames, "The procedural materials: wood, fabric, rock, ...");
+  py::class_<MaterialConfig>(m, "MaterialConfig", "config/materials/<name>.yaml")
+      .def_static("load", &loadMaterialConfig, py::arg("yaml_path"))
+      .def_readonly("name", &MaterialConfig::name)
+      .def_readonly("beta_mm", &MaterialConfig::beta_mm, "texture depth, mm")
+      .def_readonly("friction", &MaterialConfig::friction, "Coulomb coefficient against the gel")
+      .def_readonly("mm_per_texel", &MaterialConfig::mm_per_texel)
+      .def_readonly("size", &MaterialConfig::size)
+      .def_readonly("variant_count", &MaterialConfig::variant_count);
+  m.def(
+      "material_texture",
+      [](const std::string& material_config, const TexturedMesh& mesh, int variant,
+         std::uint64_t seed) {
+        TextureSource source;
+        source.material_config = material_config;
+        source.variant = variant;
+        source.seed = seed;
+        return textureFor(source, mesh);
+      },
+      py::arg("material_config"), py::arg("mesh"), py::arg("variant") = 0, py::arg("seed") = 0,
+      "Generates variant `variant` (0 = the yaml's own values) of a material for the mesh's UV "
+      "layout (a mesh without UVs is unwrapped): returns (HeightAtlas, TexturedMesh it is for "
+      "(render this one), the material's beta_mm, description). ~0.5 s for a 1024^2 atlas.");
+
+  py::class_<RenderedFrame>(m, "RenderedFrame", "One DIGIT frame (copies, yours to keep).")
+      .def_readonly("image", &RenderedFrame::image, "(rows, cols, 3) uint8, bgr8")
+      .def_readonly("depth", &RenderedFrame::depth,
+                    "(rows, cols) float32: the gel's deformation, metres")
+      .def_readonly("contact_mask", &RenderedFrame::contact_mask,
+                    "(rows, cols) uint8: 255 where the object touches the gel")
+      .def_readonly("textured", &RenderedFrame::textured, "whether the texture overlay ran");
+
+  py::class_<TactileRenderer>(
+      m, "TactileRenderer",
+      "One DIGIT's rendering: object pose in the gel frame -> H_sensor -> H_final = H_sensor + "
+      "beta H_local -> gel smoothing -> DIGIT shading (+ noise). Not thread-safe: one per "
+      "thread or sensor.")
+      .def(py::init<const SensorModel&>(), py::arg("sensor") = makeDigitSensorModel())
+      .def(
+          "set_object",
+          [](TactileRenderer& r, std::shared_ptr<TexturedMesh> mesh,
+             std::shared_ptr<HeightAtlas> atlas, double beta_mm) {
+            return r.setObject(mesh, atlas, atlas ? beta_mm : 0.0);
+          },
+          py::arg("mesh"), py::arg("atlas") = nullptr, py::arg("beta_mm") = 0.0,
+          "The object to render, with H_global `atlas` at depth beta_mm (mm; 0 or no atlas: "
+          "textureless). Returns a warning ('' if none), e.g. texture asked for a mesh "
+          "without UVs.")
+      .def(
+          "render",
+          [](TactileRenderer& r, const py::object& object_in_gel, std::int64_t noise_seed) {
+            const Eigen::Isometry3d pose = poseFromPython(object_in_gel, "object_in_gel");
+            const TactileFrame* frame;
+            {
+              py::gil_scoped_release release;
+              frame = &r.render(pose, noise_seed);
+            }
+            return copyFrame(*frame);
+          },
+          py::arg("object_in_gel"), py::arg("noise_seed") = -1,
+          "Renders the object at `object_in_gel` (the object frame in the gel frame, metres: a "
+          "4x4 matrix or (xyz, quaternion xyzw)); noise drawn from noise_seed (< 0: none). "
+          "Returns a RenderedFrame. Raises norm2tex.Error for a non-finite pose or no object.")
+      .def_property_readonly("background",
+                             [](const TactileRenderer& r) { return toNumpy(r.shader().background()); },
+                             "the no-contact frame without noise, (rows, cols, 3) uint8")
+      .def_property_readonly("sensor", &TactileRenderer::model);
+}
+
+}  // namespace python
+}  // namespace norm2tex

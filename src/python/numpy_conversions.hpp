@@ -1,0 +1,36 @@
+#pragma once
+
+// numpy <-> OpenCV / Eigen for the bindings: shapes and dtypes checked, one copy each way.
+//
+// Why copies: the renderer and the simulation reuse their frame buffers at the next call, so a
+// view handed to Python would change under the user; images are 230 kB, one copy costs ~20 us.
+
+#include <string>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+namespace norm2tex {
+namespace python {
+
+namespace py = pybind11;
+
+/// A new numpy array with the matrix's rows x cols (x channels when > 1), of its element type.
+py::array toNumpy(const cv::Mat& mat);
+
+/// A new cv::Mat of `type` from a C-contiguous (or castable) numpy array of shape (rows, cols)
+/// or (rows, cols, channels); throws ValueError naming `what` for another shape or dtype.
+cv::Mat fromNumpy(const py::handle& array, int type, const std::string& what);
+
+/// A pose from Python: a 4 x 4 homogeneous matrix, or (xyz, quaternion xyzw) -- metres. Throws
+/// ValueError naming `what` for another shape, a non-unit quaternion or a non-rigid rotation.
+/// A non-finite pose is passed on, for the C++ call to refuse with its own message.
+Eigen::Isometry3d poseFromPython(const py::handle& pose, const std::string& what);
+
+/// A pose as a 4 x 4 float64 numpy array.
+py::array_t<double> poseToNumpy(const Eigen::Isometry3d& pose);
+
+}  // namespace python
+}  // namespace norm2tex
