@@ -42,7 +42,7 @@ RenderedFrame copyFrame(const TactileFrame& frame) {
 }
 
 py::array_t<float> vectorsToNumpy(const std::vector<Eigen::Vector3f>& v) {
-  py::array_t<float> out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+  py::array_t<float> out({static_cast<Py_ssize_t>(v.size()), Py_ssize_t{3}});
   auto a = out.mutable_unchecked<2>();
   for (std::size_t i = 0; i < v.size(); ++i)
     for (int k = 0; k < 3; ++k) a(i, k) = v[i][k];
@@ -64,7 +64,7 @@ py::tuple textureFor(const TextureSource& source, const TexturedMesh& mesh) {
 
 }  // namespace
 
-void bindRender(py::module_& m) {
+void bindRender(py::module& m) {
   py::class_<SensorModel>(m, "SensorModel",
                           "Everything about one DIGIT that the renderer needs (config/digit.yaml). "
                           "Gel frame: origin at the centre of the undeformed gel surface, +x image "
@@ -101,9 +101,9 @@ void bindRender(py::module_& m) {
              }
              std::vector<Eigen::Vector3f> v(vertices.shape(0));
              std::vector<Eigen::Vector3i> t(triangles.shape(0));
-             for (py::ssize_t i = 0; i < vertices.shape(0); ++i)
+             for (Py_ssize_t i = 0; i < vertices.shape(0); ++i)
                v[i] = {vertices.at(i, 0), vertices.at(i, 1), vertices.at(i, 2)};
-             for (py::ssize_t i = 0; i < triangles.shape(0); ++i)
+             for (Py_ssize_t i = 0; i < triangles.shape(0); ++i)
                t[i] = {triangles.at(i, 0), triangles.at(i, 1), triangles.at(i, 2)};
              return std::make_shared<TexturedMesh>(std::move(v), std::move(t));
            }),
@@ -115,8 +115,8 @@ void bindRender(py::module_& m) {
                              "(N, 3) float32, metres")
       .def_property_readonly("triangles",
                              [](const TexturedMesh& mesh) {
-                               py::array_t<int> out({static_cast<py::ssize_t>(mesh.triangles().size()),
-                                                     py::ssize_t{3}});
+                               py::array_t<int> out({static_cast<Py_ssize_t>(mesh.triangles().size()),
+                                                     Py_ssize_t{3}});
                                auto a = out.mutable_unchecked<2>();
                                for (std::size_t i = 0; i < mesh.triangles().size(); ++i)
                                  for (int k = 0; k < 3; ++k) a(i, k) = mesh.triangles()[i][k];
@@ -159,7 +159,7 @@ void bindRender(py::module_& m) {
       "H_global: the baked height map of a texture over the UV square, with its validity mask. "
       "Row 0 is v = 1 (OpenGL/glTF UVs). Heights are normalised (a material: [-1, 1]) or, at "
       "physical scale, millimetres.")
-      .def(py::init([](const py::array& heights, const py::array& valid) {
+      .def(py::init([](const py::array& heights, const py::object& valid) {
              cv::Mat1f h = fromNumpy(heights, CV_32FC1, "heights");
              cv::Mat1b v = valid.is_none() ? cv::Mat1b(h.size(), 255)
                                            : cv::Mat1b(fromNumpy(valid, CV_8UC1, "valid"));

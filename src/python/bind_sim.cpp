@@ -55,8 +55,8 @@ std::optional<double> offsetFrom(const py::object& value) {
 /// The frames of every gripper of a batch for one sensor, stacked: (N, rows, cols, 3) uint8.
 py::array stackImages(const TactileGripperBatch& batch, Finger finger) {
   const cv::Mat3b& first = batch.gripper(0).frame(finger).image;
-  const py::ssize_t n = batch.size(), rows = first.rows, cols = first.cols;
-  py::array_t<std::uint8_t> out({n, rows, cols, py::ssize_t{3}});
+  const Py_ssize_t n = batch.size(), rows = first.rows, cols = first.cols;
+  py::array_t<std::uint8_t> out({n, rows, cols, Py_ssize_t{3}});
   const std::size_t bytes = static_cast<std::size_t>(rows * cols * 3);
   for (int i = 0; i < batch.size(); ++i) {
     const cv::Mat3b& image = batch.gripper(i).frame(finger).image;
@@ -67,7 +67,7 @@ py::array stackImages(const TactileGripperBatch& batch, Finger finger) {
 
 }  // namespace
 
-void bindSim(py::module_& m) {
+void bindSim(py::module& m) {
   py::class_<GripperOptions>(m, "GripperOptions", "scene yaml section gripper")
       .def_readwrite("base_height_m", &GripperOptions::base_height_m)
       .def_readwrite("min_gap_m", &GripperOptions::min_gap_m, "gel gap at opening 0, m")
@@ -217,6 +217,18 @@ void bindSim(py::module_& m) {
           "(clamped); then every gripper advances `frames` sensor frames and both sensors render. "
           "An invalid command raises and moves nothing.")
       .def(
+          "step_one",
+          [](TactileGripperBatch& b, int i, int mode, double value, int frames) {
+            TactileGripper& g = b.gripper(i);
+            py::gil_scoped_release release;
+            if (mode == 1) g.sim().setOpening(value);
+            if (mode == 2) g.sim().addOpening(value);
+            g.step(frames);
+          },
+          py::arg("index"), py::arg("mode"), py::arg("value"), py::arg("frames") = 1,
+          "Steps gripper `index` alone (on this thread): its command (mode as in step()), "
+          "`frames` frames, both sensors rendered. The others stand still.")
+      .def(
           "reset",
           [](TactileGripperBatch& b, int i, std::uint64_t seed, const py::object& height_offset_m,
              int variant) {
@@ -240,13 +252,13 @@ void bindSim(py::module_& m) {
              const Finger f = fingerFrom(finger);
              py::list out;
              for (int i = 0; i < b.size(); ++i) out.append(toNumpy(b.gripper(i).frame(f).depthMetres()));
-             return py::module_::import("numpy").attr("stack")(out);
+             return py::module::import("numpy").attr("stack")(out);
            }, py::arg("finger"), "(N, rows, cols) float32 gel deformation, metres")
       .def("contact_masks", [](const TactileGripperBatch& b, const std::string& finger) {
              const Finger f = fingerFrom(finger);
              py::list out;
              for (int i = 0; i < b.size(); ++i) out.append(toNumpy(b.gripper(i).frame(f).contact_mask));
-             return py::module_::import("numpy").attr("stack")(out);
+             return py::module::import("numpy").attr("stack")(out);
            }, py::arg("finger"), "(N, rows, cols) uint8, 255 in contact")
       .def("background", [](const TactileGripperBatch& b, const std::string& finger) {
              return toNumpy(b.gripper(0).background(fingerFrom(finger)));
@@ -254,10 +266,10 @@ void bindSim(py::module_& m) {
       .def(
           "state",
           [](const TactileGripperBatch& b) {
-            const py::ssize_t n = b.size();
-            py::array_t<double> opening(n), commanded(n), force({n, py::ssize_t{2}}),
-                penetration({n, py::ssize_t{2}});
-            py::array_t<bool> dropped(n), in_contact({n, py::ssize_t{2}}), too_deep({n, py::ssize_t{2}});
+            const Py_ssize_t n = b.size();
+            py::array_t<double> opening(n), commanded(n), force({n, Py_ssize_t{2}}),
+                penetration({n, Py_ssize_t{2}});
+            py::array_t<bool> dropped(n), in_contact({n, Py_ssize_t{2}}), too_deep({n, Py_ssize_t{2}});
             py::array_t<std::int64_t> frame(n);
             for (int i = 0; i < b.size(); ++i) {
               const TactileGripper& g = b.gripper(i);
@@ -292,6 +304,10 @@ void bindSim(py::module_& m) {
       .def("set_noise_seed", [](TactileGripperBatch& b, int i, std::int64_t seed) {
              b.gripper(i).setNoiseSeed(seed);
            }, py::arg("index"), py::arg("noise_seed"), "from gripper index's next frame on (< 0: none)")
+      .def("object_in_gel", [](const TactileGripperBatch& b, int i, const std::string& finger) {
+             return poseToNumpy(b.gripper(i).objectInGel(fingerFrom(finger)));
+           }, py::arg("index"), py::arg("finger"),
+           "The pose gripper index's sensor renders the object at (4x4, object in gel frame, m)")
       .def("variant", [](const TactileGripperBatch& b, int i) { return b.gripper(i).variant(); })
       .def("beta_mm", [](const TactileGripperBatch& b, int i) { return b.gripper(i).betaMm(); })
       .def("friction", [](const TactileGripperBatch& b, int i) { return b.gripper(i).friction(); })

@@ -7,9 +7,9 @@ namespace python {
 
 /// SensorModel, TexturedMesh and object loading, HeightAtlas and baking, materials,
 /// TactileRenderer (bind_render.cpp).
-void bindRender(pybind11::module_& m);
+void bindRender(pybind11::module& m);
 /// The scene config, GripperSim, TactileGripper and TactileGripperBatch (bind_sim.cpp).
-void bindSim(pybind11::module_& m);
+void bindSim(pybind11::module& m);
 
 }  // namespace python
 }  // namespace norm2tex

@@ -22,7 +22,7 @@ py::dtype dtypeOf(int depth) {
 }  // namespace
 
 py::array toNumpy(const cv::Mat& mat) {
-  std::vector<py::ssize_t> shape = {mat.rows, mat.cols};
+  std::vector<Py_ssize_t> shape = {mat.rows, mat.cols};
   if (mat.channels() > 1) shape.push_back(mat.channels());
   py::array out(dtypeOf(mat.depth()), shape);
   const std::size_t row_bytes = mat.cols * mat.elemSize();

@@ -87,6 +87,9 @@ class TactileGripper {
   void stepPhysics(int frames = 1);
   /// Renders one sensor at the current state.
   void render(Finger finger);
+  /// The pose a sensor renders the object at: the object frame in its gel frame, metres (as the
+  /// renderer node reads it from TF).
+  Eigen::Isometry3d objectInGel(Finger finger) const;
 
   /// The latest rendered frame of a sensor (valid until its next render).
   const TactileFrame& frame(Finger finger) const { return *frames_[index(finger)]; }

@@ -20,6 +20,7 @@ class InProcessBackend:
                                                                    grasp_opening)
       set_noise_seed(i, noise_seed)
       step(modes, values, frames=1)      # per gripper: KEEP / ABSOLUTE / DELTA and a value
+      step_one(i, mode, value, frames=1)  # gripper i alone (the others stand still)
       images(finger) -> (N, rows, cols, 3) uint8     finger: "left" / "right"
       depths(finger) -> (N, rows, cols) float32 m
       background(finger) -> (rows, cols, 3) uint8    (no contact, no noise)
@@ -71,6 +72,9 @@ class InProcessBackend:
             options.append(o)
         self.batch = norm2tex.TactileGripperBatch(scene_config, sensor_model, options, threads)
         self.size = count
+        self.has_material = bool(material_path)
+        # Noise drawn per episode from a seed the environment gives (set_noise_seed).
+        self.noise_per_episode = bool(noise_per_episode)
         self.frame_seconds = self.batch.frame_seconds
         self.height_offset_range = self.batch.sim(0).height_offset_range
         self.beta_mm = self.batch.beta_mm(0)
@@ -79,6 +83,8 @@ class InProcessBackend:
 
     def reset(self, i, seed, height_offset_m=None, variant=None):
         offset = None if height_offset_m is None or math.isnan(height_offset_m) else height_offset_m
+        if not self.has_material:
+            variant = None  # no texture to vary
         return self.batch.reset(i, int(seed), offset, -1 if variant is None else int(variant))
 
     def prefetch_variant(self, variant):
@@ -89,6 +95,9 @@ class InProcessBackend:
 
     def step(self, modes, values, frames=1):
         self.batch.step(list(modes), [float(v) for v in values], int(frames))
+
+    def step_one(self, i, mode, value, frames=1):
+        self.batch.step_one(i, int(mode), float(value), int(frames))
 
     def images(self, finger):
         return self.batch.images(finger)

@@ -160,10 +160,11 @@ void TactileGripper::render(Finger finger) {
   const std::int64_t frame =
       options_.noise_per_episode ? frameIndex() - episode_first_frame_ : frameIndex();
   const std::int64_t noise_seed = options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
-  // As the renderer node reads it from TF: the object frame in the gel frame.
-  const Eigen::Isometry3d object_in_gel =
-      sim_->gelInWorld(finger).inverse() * sim_->objectInWorld();
-  frames_[index(finger)] = &renderers_[index(finger)]->render(object_in_gel, noise_seed);
+  frames_[index(finger)] = &renderers_[index(finger)]->render(objectInGel(finger), noise_seed);
+}
+
+Eigen::Isometry3d TactileGripper::objectInGel(Finger finger) const {
+  return sim_->gelInWorld(finger).inverse() * sim_->objectInWorld();
 }
 
 void TactileGripper::step(int frames) {

@@ -1,0 +1,182 @@
+"""norm2tex._core against the C++ tools and analytic expectations (pytest).
+
+Needs the devel (or install) space's environment: `import norm2tex` must find the compiled
+module. NORM2TEX_TOOLS_DIR (default: beside the devel space's lib/norm2tex) holds norm2tex_render.
+"""
+
+import math
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import norm2tex
+
+TOOLS_DIR = os.environ.get("NORM2TEX_TOOLS_DIR", "")
+POSE_TEXT = "0.001 -0.002 0.015 0.05 -0.03 0.4"  # x y z roll pitch yaw: metres, radians
+PRESS_MM = 1.0
+
+
+def pose_matrix(x, y, z, roll, pitch, yaw):
+    """The CLI's --pose: R = Rz(yaw) Ry(pitch) Rx(roll), as 4x4."""
+    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
+                              math.cos(yaw), math.sin(yaw))
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    m = np.eye(4)
+    m[:3, :3] = rz @ ry @ rx
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def read_png(path):
+    """An 8-bit PNG as (rows, cols, 3) bgr: through the package's own renderer-free reader."""
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(path).convert("RGB"))
+    return np.ascontiguousarray(rgb[..., ::-1])
+
+
+@pytest.fixture(scope="module")
+def sensor():
+    return norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+
+
+@pytest.fixture(scope="module")
+def cube():
+    return norm2tex.load_object_mesh("box:30x30x30")["mesh"]
+
+
+def test_render_equals_the_cli_frame_bit_for_bit(sensor, cube, tmp_path):
+    tool = os.path.join(TOOLS_DIR, "norm2tex_render")
+    if not os.path.exists(tool):
+        pytest.skip("norm2tex_render not found in NORM2TEX_TOOLS_DIR=%r" % TOOLS_DIR)
+    out = str(tmp_path / "cli.png")
+    depth_out = str(tmp_path / "cli_depth.tiff")
+    subprocess.run([tool, "--mesh", "box:30x30x30", "--pose", POSE_TEXT, "--press-mm",
+                    str(PRESS_MM), "--material", "wood", "--seed", "7", "--sensor",
+                    norm2tex.config_path("digit.yaml"), "-o", out, "--depth-out", depth_out],
+                   check=True, capture_output=True)
+    atlas, mesh, beta_mm, _ = norm2tex.material_texture(norm2tex.material_config("wood"), cube,
+                                                         variant=0, seed=7)
+    renderer = norm2tex.TactileRenderer(sensor)
+    assert renderer.set_object(mesh, atlas, beta_mm) == ""
+    values = [float(v) for v in POSE_TEXT.split()]
+    values[2] -= PRESS_MM * 1e-3
+    frame = renderer.render(pose_matrix(*values), noise_seed=7)
+    assert frame.textured
+    assert frame.image.shape == (320, 240, 3) and frame.image.dtype == np.uint8
+    assert frame.depth.dtype == np.float32 and frame.contact_mask.dtype == np.uint8
+    cli = read_png(out)
+    assert np.count_nonzero(frame.contact_mask) > 1000  # a real press, not an empty frame
+    np.testing.assert_array_equal(frame.image, cli)
+
+
+def test_quaternion_pose_equals_the_matrix(sensor, cube):
+    renderer = norm2tex.TactileRenderer(sensor)
+    renderer.set_object(cube)
+    m = pose_matrix(0.0, 0.0, 0.0145, 0.0, 0.0, math.pi / 2)
+    a = renderer.render(m).image
+    b = renderer.render(((0.0, 0.0, 0.0145), (0.0, 0.0, math.sin(math.pi / 4),
+                                               math.cos(math.pi / 4)))).image
+    # The quaternion's matrix may differ from the product of axis rotations in the last bit.
+    assert np.mean(a != b) < 1e-3
+
+
+def test_a_ball_press_matches_hertz_geometry(sensor):
+    ball = norm2tex.load_object_mesh("sphere:10")["mesh"]
+    renderer = norm2tex.TactileRenderer(sensor)
+    renderer.set_object(ball)
+    px_mm2 = sensor.mm_per_pixel**2
+    for press_mm in (0.3, 0.6, 1.0):
+        frame = renderer.render(pose_matrix(0.0, 0.0, 0.010 - press_mm * 1e-3, 0, 0, 0))
+        area_mm2 = np.count_nonzero(frame.contact_mask) * px_mm2
+        # A sphere of radius R cut at depth d: a disc of radius sqrt(2 R d - d^2).
+        expected = math.pi * (2 * 10.0 * press_mm - press_mm**2)
+        assert area_mm2 == pytest.approx(expected, rel=0.05)
+        # The gel's deepest point is the press itself (the smoothing keeps the contact core).
+        assert float(frame.depth.max()) == pytest.approx(press_mm * 1e-3, rel=0.03)
+
+
+def test_errors_carry_the_cpp_message(sensor, cube):
+    with pytest.raises(norm2tex.Error, match="/no/such/mesh.obj"):
+        norm2tex.load_object_mesh("/no/such/mesh.obj")
+    renderer = norm2tex.TactileRenderer(sensor)
+    renderer.set_object(cube)
+    nan_pose = np.eye(4)
+    nan_pose[0, 3] = float("nan")
+    with pytest.raises(norm2tex.Error, match="finite"):
+        renderer.render(nan_pose)
+    with pytest.raises(ValueError, match="valid: .*wood"):
+        norm2tex.material_config("granite")
+    with tempfile.NamedTemporaryFile("w", suffix=".yaml") as bad:
+        bad.write("material: wood\nbeta_mm: 7\n")
+        bad.flush()
+        with pytest.raises(norm2tex.Error, match="beta_mm"):
+            norm2tex.MaterialConfig.load(bad.name)
+    with pytest.raises(ValueError, match="4x4"):
+        renderer.render(np.eye(3))
+    with pytest.raises(norm2tex.Error, match="no object"):
+        norm2tex.TactileRenderer(sensor).render(np.eye(4))
+    # The exception type is RuntimeError's, so code catching RuntimeError still works.
+    assert issubclass(norm2tex.Error, RuntimeError)
+
+
+def test_gripper_sim_is_deterministic_and_refuses_bad_offsets(sensor):
+    scene = norm2tex.SceneConfig.load(norm2tex.scene_config("cube"))
+
+    def run():
+        sim = norm2tex.GripperSim(scene, sensor)
+        start = sim.reset(3)
+        sim.set_opening(0.6)
+        sim.step(200)
+        return start, sim.object_in_world(), sim.contact("left")
+
+    a, b = run(), run()
+    assert a[0] == b[0]
+    np.testing.assert_array_equal(a[1], b[1])
+    assert a[2]["normal_force_n"] == b[2]["normal_force_n"] > 0.0
+    sim = norm2tex.GripperSim(scene, sensor)
+    low, high = sim.height_offset_range
+    with pytest.raises(norm2tex.Error, match="offset"):
+        sim.reset(0, high + 0.01)
+    with pytest.raises(ValueError, match="left, right"):
+        sim.contact("middle")
+
+
+def test_no_leak_over_ten_thousand_renders(sensor, cube):
+    renderer = norm2tex.TactileRenderer(sensor)
+    atlas, mesh, beta_mm, _ = norm2tex.material_texture(norm2tex.material_config("wood"), cube)
+    renderer.set_object(mesh, atlas, beta_mm)
+    pose = pose_matrix(0.0, 0.0, 0.0142, 0.1, 0.0, 0.0)
+
+    def rss_kib():
+        with open("/proc/self/status") as status:
+            for line in status:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1])
+        return 0
+
+    for _ in range(200):  # warm: buffers and allocator arenas reach their size
+        renderer.render(pose, noise_seed=1)
+    before = rss_kib()
+    for i in range(10000):
+        frame = renderer.render(pose, noise_seed=i)
+    after = rss_kib()
+    assert frame.image.shape == (320, 240, 3)
+    # A leak of one frame's copies (image, depth, mask: ~620 kB) per render would be 6 GB.
+    assert after - before < 20 * 1024, "RSS grew by %d KiB over 10 000 renders" % (after - before)
+
+
+def test_height_atlas_round_trip_and_bake():
+    heights = np.linspace(-1, 1, 64 * 32, dtype=np.float32).reshape(32, 64)
+    atlas = norm2tex.HeightAtlas(heights)
+    np.testing.assert_array_equal(atlas.heights, heights)
+    assert atlas.shape == (32, 64)
+    # Texel centre (row 0, column 0) is u = 0.5 / 64, v = 1 - 0.5 / 32.
+    assert atlas.sample(0.5 / 64, 1 - 0.5 / 32) == pytest.approx(heights[0, 0])
+    with pytest.raises(ValueError, match="dtype"):
+        norm2tex.HeightAtlas(heights.astype(np.float64))

@@ -1,0 +1,198 @@
+"""norm2tex.envs: the Gymnasium API's promises, the paper's task, batches (pytest)."""
+
+import numpy as np
+import pytest
+
+import norm2tex
+from norm2tex.envs import (
+    GripperEnv,
+    GripperVectorEnv,
+    HoldCubeEnv,
+    HoldCubeVectorEnv,
+    hold_reward,
+    spaces,
+)
+
+
+def assert_obs_equal(a, b):
+    assert a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {},
+        {"image": "diff_int16", "downscale": 4, "depth": True},
+        {"image": "diff_float", "downscale": 2, "action": "delta", "force": False},
+        {"action": "absolute", "material": None, "noise": False},
+    ],
+)
+def test_spaces_contain_every_observation(kwargs):
+    env = GripperEnv(**kwargs)
+    obs, info = env.reset(seed=3)
+    assert env.observation_space.contains(obs), {k: (v.dtype, v.shape) for k, v in obs.items()}
+    for _ in range(5):
+        action = env.action_space.sample()
+        assert env.action_space.contains(action)
+        obs, reward, terminated, truncated, info = env.step(action)
+        assert env.observation_space.contains(obs)
+    if kwargs.get("downscale"):
+        assert obs["digit_left"].shape == (320 // kwargs["downscale"], 240 // kwargs["downscale"], 3)
+    env.close()
+
+
+def test_reset_with_a_seed_repeats_the_episode():
+    env = HoldCubeEnv()
+    actions = [2, 2, 1, 0, 2, 2, 2, 1, 2, 0] * 3
+
+    def rollout(seed):
+        obs, info = env.reset(seed=seed)
+        frames = [obs]
+        for a in actions:
+            frames.append(env.step(a)[0])
+        return info, frames
+
+    info_a, a = rollout(11)
+    info_b, b = rollout(11)
+    info_c, c = rollout(12)
+    assert info_a["seed"] == info_b["seed"] and info_a["variant"] == info_b["variant"]
+    for x, y in zip(a, b):
+        assert_obs_equal(x, y)
+    # Another seed is another episode (so the comparison above can fail).
+    assert not np.array_equal(a[0]["digit_left"], c[0]["digit_left"])
+    env.close()
+
+
+def test_reward_is_the_papers_curve():
+    assert hold_reward(0.5) == pytest.approx(0.0, abs=1e-12)
+    assert hold_reward(0.6) == pytest.approx(0.5, abs=1e-12)
+    assert hold_reward(0.7) == pytest.approx(1.0, abs=1e-12)
+    assert hold_reward(0.3) == 0.0 and hold_reward(0.9) == 1.0
+    xs = np.linspace(0.5, 0.7, 41)
+    assert np.all(np.diff([hold_reward(x) for x in xs]) > 0)
+
+
+def test_opening_wide_drops_the_cube_with_reward_zero():
+    env = HoldCubeEnv(noise=False)
+    obs, info = env.reset(seed=5)
+    assert 0.45 <= obs["opening"][0] <= 0.55
+    assert np.all(obs["force"] > 30.0)  # the grasp at full pressure (35 N limit)
+    rewards = []
+    for step in range(128):
+        obs, reward, terminated, truncated, info = env.step(2)  # open by 0.005 each step
+        rewards.append(reward)
+        if terminated or truncated:
+            break
+    assert terminated and not truncated and info["dropped"]
+    assert reward == 0.0
+    # Before the drop it was rewarded as the curve says for its opening.
+    assert rewards[-2] == pytest.approx(hold_reward(obs["opening"][0] - 0.005), abs=1e-6)
+    # The cube drops past the measured hold threshold of the scene (0.615-0.6175).
+    assert 0.6 < obs["opening"][0] < 0.66
+    env.close()
+
+
+def test_truncation_at_128_steps():
+    env = HoldCubeEnv(noise=False, image="diff_int16", downscale=4)
+    env.reset(seed=2)
+    for step in range(1, 129):
+        obs, reward, terminated, truncated, info = env.step(1)  # hold at the start opening
+        assert not terminated
+        assert truncated == (step == 128)
+        assert reward == pytest.approx(hold_reward(obs["opening"][0]), abs=1e-6)
+    env.close()
+
+
+def test_beta_zero_gives_the_textureless_render():
+    env = GripperEnv(beta_mm=0.0, noise=False)
+    textured = GripperEnv(noise=False)
+    obs, _ = env.reset(seed=4, options={"height_offset_m": 0.005})
+    obs_textured, _ = textured.reset(seed=4, options={"height_offset_m": 0.005})
+    sensor = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    renderer = norm2tex.TactileRenderer(sensor)
+    renderer.set_object(norm2tex.load_object_mesh("box:30x30x30")["mesh"])
+    pose = env.backend.batch.object_in_gel(0, "left")
+    expected = renderer.render(pose).image
+    np.testing.assert_array_equal(obs["digit_left"], expected)
+    # The same state with the wood texture is another image.
+    np.testing.assert_array_equal(pose, textured.backend.batch.object_in_gel(0, "left"))
+    assert np.count_nonzero(obs_textured["digit_left"] != expected) > 1000
+    env.close()
+    textured.close()
+
+
+def test_a_batch_of_four_equals_four_single_environments():
+    actions = np.random.default_rng(0).integers(0, 3, size=(40, 4))
+    actions[:, 0] = 2  # environment 0 opens until the cube drops: the batch's autoreset runs
+    vector = HoldCubeVectorEnv(num_envs=4, image="diff_int16", downscale=2)
+    obs, infos = vector.reset(seed=100)
+    batch_obs = [obs]
+    batch_rewards, batch_done, batch_infos = [], [], []
+    for a in actions:
+        obs, rewards, terminated, truncated, infos = vector.step(list(a))
+        batch_obs.append(obs)
+        batch_rewards.append(rewards)
+        batch_done.append(terminated | truncated)
+        batch_infos.append(infos)
+    vector.close()
+    assert any(done[0] for done in batch_done)
+    for i in range(4):
+        env = HoldCubeEnv(image="diff_int16", downscale=2)
+        obs, info = env.reset(seed=100 + i)
+        assert_obs_equal(obs, GripperVectorEnv._row(batch_obs[0], i))
+        for t, a in enumerate(actions[:, i]):
+            obs, reward, terminated, truncated, info = env.step(int(a))
+            assert reward == batch_rewards[t][i]
+            assert (terminated or truncated) == batch_done[t][i]
+            if terminated or truncated:
+                # The batch reset it at once (same-step autoreset) and kept the last one.
+                assert_obs_equal(obs, batch_infos[t][i]["final_observation"])
+                break
+            assert_obs_equal(obs, GripperVectorEnv._row(batch_obs[t + 1], i))
+        env.close()
+
+
+def test_the_episode_rotates_texture_variants():
+    env = HoldCubeEnv(noise=False, variant=[0, 5, 9])
+    seen = {env.reset(seed=s)[1]["variant"] for s in range(12)}
+    assert seen == {0, 5, 9}
+    env.close()
+
+
+def test_bad_arguments_are_refused_clearly():
+    with pytest.raises(ValueError, match="action"):
+        GripperEnv(action="joystick")
+    with pytest.raises(ValueError, match="valid: .*wood"):
+        GripperEnv(material="granite")
+    env = GripperEnv(noise=False)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="0 \\(close\\)"):
+        env.step(3)
+    with pytest.raises(norm2tex.Error, match="offset"):
+        env.reset(seed=0, options={"height_offset_m": 0.5})
+    env.close()
+
+
+def test_local_spaces_behave_like_gymnasiums():
+    box = spaces.LocalBox(0, 255, shape=(4, 3), dtype=np.uint8, seed=1)
+    assert box.contains(box.sample())
+    assert not box.contains(np.full((4, 3), 255, dtype=np.int32) + 1)
+    assert not box.contains(np.zeros((3, 4), dtype=np.uint8))
+    discrete = spaces.LocalDiscrete(3, seed=1)
+    assert all(discrete.contains(discrete.sample()) for _ in range(20))
+    assert not discrete.contains(3) and not discrete.contains(-1)
+    d = spaces.LocalDict({"a": box, "b": discrete})
+    assert d.contains(d.sample()) and not d.contains({"a": box.sample()})
+
+
+def test_gymnasium_env_checker():
+    if not spaces.HAVE_GYMNASIUM:
+        pytest.skip("gymnasium is not installed (Debian 12 does not package it): the "
+                    "environments use norm2tex.envs.spaces; pip install gymnasium to run this")
+    from gymnasium.utils.env_checker import check_env
+
+    env = HoldCubeEnv(image="diff_int16", downscale=4)
+    check_env(env, skip_render_check=True)
+    env.close()
