@@ -30,7 +30,7 @@ PROGRAMS = [
     "norm2tex_bake", "norm2tex_texgen", "norm2tex_render", "norm2tex_calibrate", "norm2tex_export",
     "norm2tex_grasp_demo", "norm2tex_gripper_sweep", "norm2tex_make_demo_normal_map",
     "norm2tex_ros_bench", "norm2tex_wake_bench", "norm2tex_launch_check",
-    "record_dataset", "free_port", "merge_dataset", "train_material_classifier", "ros_benchmark",
+    "record_dataset", "free_port", "merge_dataset", "train_material_classifier", "ros_benchmark", "env_benchmark",
     "slurm/submit_dataset", "slurm/record_dataset.sbatch",
 ]
 
@@ -112,6 +112,27 @@ class InstallSpace(unittest.TestCase):
                     "-o", out], self.env, 120)
         self.assertEqual(made.returncode, 0, made.stdout + made.stderr)
         self.assertTrue(os.path.getsize(out) > 0)
+
+    def test_the_python_module_runs_from_the_install_space(self):
+        # norm2tex._core, norm2tex.envs and catkin's generated messages share one package.
+        script = (
+            "import norm2tex, norm2tex.envs\n"
+            "from norm2tex.msg import TactileContact\n"
+            "from norm2tex.srv import Step\n"
+            "print(norm2tex.__file__)\n"
+            "print(norm2tex._core.__file__)\n"
+            "print(norm2tex.config_dir())\n"
+            "env = norm2tex.envs.HoldCubeEnv(noise=False)\n"
+            "obs, info = env.reset(seed=1)\n"
+            "print(obs['digit_left'].shape, obs['digit_left'].dtype)\n"
+        )
+        ran = run(["/usr/bin/python3", "-c", script], self.env, 300)
+        self.assertEqual(ran.returncode, 0, ran.stdout + ran.stderr)
+        lines = ran.stdout.split("\n")
+        for path in lines[:3]:
+            self.assertTrue(path.startswith(self.prefix + os.sep), ran.stdout)
+        self.assertEqual(lines[2], os.path.join(self.prefix, "share", "norm2tex", "config"))
+        self.assertEqual(lines[3], "(320, 240, 3) uint8")
 
     def test_gripper_sim_launch_publishes_images_of_both_fingers(self):
         port = self.free_port()

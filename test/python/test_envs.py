@@ -196,3 +196,17 @@ def test_gymnasium_env_checker():
     env = HoldCubeEnv(image="diff_int16", downscale=4)
     check_env(env, skip_render_check=True)
     env.close()
+
+
+def test_the_readme_python_examples_run():
+    """README's "From Python" examples, as written there."""
+    import os
+    import re
+
+    readme = os.path.join(os.path.dirname(__file__), "..", "..", "README.md")
+    with open(readme) as f:
+        section = f.read().split("## From Python", 1)[1].split("\n## ", 1)[0]
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert len(blocks) == 2
+    for block in blocks:
+        exec(compile(block, "README.md", "exec"), {})
