@@ -38,6 +38,21 @@ const char* const kSensorNames[2] = {"digit_left", "digit_right"};
 const char* const kGelFrames[2] = {"digit_left_gel", "digit_right_gel"};
 const char* const kFingerFrames[2] = {"finger_left", "finger_right"};
 
+/// The gripper's state at the current frame, into a ~step or ~reset response (same field names).
+template <typename Response>
+void fillState(const GripperSim& sim, std::int64_t frame, Response& response) {
+  response.frame = static_cast<std::uint64_t>(frame);
+  response.opening = sim.opening();
+  response.dropped = sim.dropped();
+  for (int i = 0; i < 2; ++i) {
+    const GelContactState& state = sim.contact(static_cast<Finger>(i));
+    response.in_contact[i] = state.in_contact;
+    response.normal_force[i] = state.normal_force_n;
+    response.penetration[i] = state.penetration_m;
+    response.too_deep[i] = state.too_deep;
+  }
+}
+
 }  // namespace
 
 ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
@@ -113,6 +128,12 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   config.physics.rate_hz = ticks_per_frame_ * params_.frame_rate;
   frame_period_ns_ = std::llround(1e9 / params_.frame_rate);
   sim_ = std::make_unique<GripperSim>(config);
+  {
+    // For clients (the Python RosBackend), before the services appear: the offsets ~reset
+    // accepts, [low, high] m.
+    const auto [low, high] = sim_->heightOffsetRange();
+    private_nh_.setParam("height_offset_range", std::vector<double>{low, high});
+  }
   for (int i = 0; i < 2; ++i) meters_[i] = std::make_unique<ContactPatchMeter>(sensor);
 
   const bool use_sim_time = ros::Time::isSimTime();
@@ -302,8 +323,47 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
     ROS_WARN("contact_sim: %s", response.message.c_str());
     return true;
   }
+  // A new texture is checked before anything changes; it applies from the episode's first frame.
+  std::string material = params_.material;
+  int variant = params_.variant;
+  double beta_mm = beta_mm_;
+  if (request.set_texture) {
+    if (!request.material.empty()) material = request.material;
+    variant = static_cast<int>(request.variant);
+    try {
+      if (material == ros_params::kNoMaterial || request.variant > 100000) {
+        throw Error("set_texture needs a material of config/materials/ and a variant in [0, "
+                    "100000]; got material '" + material + "', variant " +
+                    std::to_string(request.variant));
+      }
+      const std::string path = materialConfigPath(material);  // throws for an unknown one
+      if (material != params_.material && params_.beta < 0.0) {
+        beta_mm = loadMaterialConfig(path).beta_mm;  // the label of what the renderers draw
+      }
+    } catch (const Error& e) {
+      response.success = false;
+      response.message = std::string("~reset refused: ") + e.what();
+      ROS_WARN("contact_sim: %s", response.message.c_str());
+      return true;
+    }
+  }
   try {
-    response.info = startEpisode(request.seed, request.height_offset);
+    const std::string old_material = params_.material;
+    const int old_variant = params_.variant;
+    const double old_beta = beta_mm_;
+    params_.material = material;
+    params_.variant = variant;
+    beta_mm_ = beta_mm;
+    try {
+      response.info = startEpisode(request.seed, request.height_offset);
+    } catch (const Error&) {
+      params_.material = old_material;  // refused: nothing changed
+      params_.variant = old_variant;
+      beta_mm_ = old_beta;
+      throw;
+    }
+    response.grasp_opening = sim_->commandedOpening();
+    fillState(*sim_, frame_, response);
     publishFrame();
     lock_step_->drain(frame_pub_);
   } catch (const Error& e) {
@@ -354,8 +414,8 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
   }
   response.success = true;
   response.stamp = frameStamp();
-  response.opening = sim_->opening();
-  response.dropped = sim_->dropped();
+  response.commanded_opening = sim_->commandedOpening();
+  fillState(*sim_, frame_, response);
   return true;
 }
 
