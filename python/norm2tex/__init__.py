@@ -34,6 +34,8 @@ _CORE_NAMES = (
     "MaterialConfig",
     "material_texture",
     "RenderedFrame",
+    "read_image",
+    "calibrate_sensor",
     "TactileRenderer",
     "GripperOptions",
     "ObjectOptions",

@@ -9,6 +9,10 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "norm2tex/calibrate/sensor_calibration.hpp"
+#include <opencv2/imgcodecs.hpp>
+
+#include "norm2tex/common/image_io.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/procedural_material.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
@@ -84,6 +88,19 @@ void bindRender(py::module& m) {
       .def_readwrite("gel_pad_height_mm", &SensorModel::gel_pad_height_mm, "physical pad, mm")
       .def_readwrite("background_image", &SensorModel::background_image,
                      "no-contact frame (bgr image file); empty: the synthetic background")
+      .def_property_readonly(
+          "shading_response_bgr",
+          [](const SensorModel& s) {
+            py::array_t<double> out({Py_ssize_t{3}, Py_ssize_t{kShadingFeatureCount}});
+            auto a = out.mutable_unchecked<2>();
+            for (int c = 0; c < 3; ++c)
+              for (int k = 0; k < kShadingFeatureCount; ++k) a(c, k) = s.shading.response_bgr[c][k];
+            return out;
+          },
+          "(3, 24) the calibrated shading response: grey levels per unit of each feature, rows B, G, R")
+      .def_property_readonly("noise_sigma_bgr", [](const SensorModel& s) {
+            return py::make_tuple(s.noise.sigma_bgr[0], s.noise.sigma_bgr[1], s.noise.sigma_bgr[2]);
+          }, "pixel noise, grey levels, per channel B, G, R")
       .def("validate", [](const SensorModel& s) { validate(s); },
            "Raises norm2tex.Error naming the first field out of range.")
       .def("__repr__", [](const SensorModel& s) {
@@ -233,6 +250,59 @@ void bindRender(py::module& m) {
       "Generates variant `variant` (0 = the yaml's own values) of a material for the mesh's UV "
       "layout (a mesh without UVs is unwrapped): returns (HeightAtlas, TexturedMesh it is for "
       "(render this one), the material's beta_mm, description). ~0.5 s for a 1024^2 atlas.");
+
+  m.def(
+      "read_image",
+      [](const std::string& path) {
+        return toNumpy(readImage(path, cv::IMREAD_COLOR, "image"));
+      },
+      py::arg("path"),
+      "Reads an image file as the package's tools do (OpenCV's decoders): (rows, cols, 3) uint8 "
+      "bgr. Raises norm2tex.Error naming the file.");
+
+  m.def(
+      "calibrate_sensor",
+      [](const SensorModel& base, const py::list& backgrounds, const py::list& presses,
+         double ball_diameter_mm, std::optional<double> mm_per_pixel, double holdout_fraction) {
+        CalibrationInput input;
+        for (std::size_t i = 0; i < backgrounds.size(); ++i) {
+          input.backgrounds.push_back(
+              {"background " + std::to_string(i), fromNumpy(backgrounds[i], CV_8UC3, "background")});
+        }
+        for (std::size_t i = 0; i < presses.size(); ++i) {
+          input.presses.push_back(
+              {"press " + std::to_string(i), fromNumpy(presses[i], CV_8UC3, "press")});
+        }
+        input.ball_diameter_mm = ball_diameter_mm;
+        input.mm_per_pixel = mm_per_pixel;
+        CalibrationOptions options;
+        options.holdout_fraction = holdout_fraction;
+        CalibrationResult result;
+        {
+          py::gil_scoped_release release;
+          result = calibrateSensor(base, input, options);
+        }
+        py::dict out;
+        out["model"] = result.model;
+        out["background"] = toNumpy(result.background);
+        out["training_presses"] = result.training_presses;
+        out["held_out_presses"] = result.held_out.presses;
+        out["variance_explained"] = result.held_out.variance_explained;
+        out["real_contact_mean"] = result.held_out.real_contact_mean;
+        out["sim_contact_mean"] = result.held_out.sim_contact_mean;
+        out["side_error_deg"] = py::make_tuple(result.held_out.side_error_deg[0],
+                                               result.held_out.side_error_deg[1],
+                                               result.held_out.side_error_deg[2]);
+        return out;
+      },
+      py::arg("base"), py::arg("backgrounds"), py::arg("presses"), py::arg("ball_diameter_mm"),
+      py::arg("mm_per_pixel") = py::none(), py::arg("holdout_fraction") = 0.3,
+      "Fits a SensorModel to your DIGIT, as norm2tex_calibrate: no-contact frames and ball "
+      "presses (lists of (rows, cols, 3) uint8 bgr of base's size), the ball's diameter (mm) and "
+      "the scale (mm per pixel; None: fitted). Returns a dict: model (SensorModel; its "
+      "background_image unset), background (the mean no-contact frame), training_presses, "
+      "held_out_presses and how well the model reproduces those: variance_explained, "
+      "real_contact_mean / sim_contact_mean (grey levels), side_error_deg (B, G, R).");
 
   py::class_<RenderedFrame>(m, "RenderedFrame", "One DIGIT frame (copies, yours to keep).")
       .def_readonly("image", &RenderedFrame::image, "(rows, cols, 3) uint8, bgr8")

@@ -180,3 +180,34 @@ def test_height_atlas_round_trip_and_bake():
     assert atlas.sample(0.5 / 64, 1 - 0.5 / 32) == pytest.approx(heights[0, 0])
     with pytest.raises(ValueError, match="dtype"):
         norm2tex.HeightAtlas(heights.astype(np.float64))
+
+
+def test_calibration_equals_the_cli_on_real_presses(sensor, tmp_path):
+    """norm2tex_calibrate's fit from Python, on 15 real DIGIT presses (test/fixtures/digit_s09)."""
+    tool = os.path.join(TOOLS_DIR, "norm2tex_calibrate")
+    if not os.path.exists(tool):
+        pytest.skip("norm2tex_calibrate not found in NORM2TEX_TOOLS_DIR=%r" % TOOLS_DIR)
+    fixtures = os.path.join(os.path.dirname(__file__), "..", "fixtures", "digit_s09")
+    presses = [os.path.join(fixtures, "frame_%d.jpg" % i) for i in range(0, 30, 2)]
+    background = os.path.join(fixtures, "frame_30.jpg")
+    yaml_path = str(tmp_path / "cli.yaml")
+    subprocess.run([tool, "--background", background, "--presses"] + presses +
+                   ["--ball-diameter-mm", "6", "--mm-per-pixel", "0.0532", "-o", yaml_path],
+                   check=True, capture_output=True)
+    cli = norm2tex.SensorModel.load(yaml_path)
+    fit = norm2tex.calibrate_sensor(
+        norm2tex.SensorModel(), [norm2tex.read_image(background)],
+        [norm2tex.read_image(p) for p in presses], ball_diameter_mm=6.0, mm_per_pixel=0.0532)
+    model = fit["model"]
+    assert model.mm_per_pixel == 0.0532
+    # The yaml holds the CLI's response at the precision it writes; the fit is the same fit.
+    np.testing.assert_allclose(model.shading_response_bgr, cli.shading_response_bgr,
+                               rtol=1e-6, atol=1e-6)
+    assert fit["training_presses"] + fit["held_out_presses"] == 15
+    # It reproduces presses it was not fitted on (the package's documented quality: > 0.8).
+    assert fit["variance_explained"] > 0.8
+    with pytest.raises(norm2tex.Error, match="press"):
+        norm2tex.calibrate_sensor(norm2tex.SensorModel(), [norm2tex.read_image(background)],
+                                  [norm2tex.read_image(presses[0])], ball_diameter_mm=6.0)
+    with pytest.raises(norm2tex.Error, match="nothing.jpg"):
+        norm2tex.read_image(os.path.join(fixtures, "nothing.jpg"))

@@ -198,3 +198,26 @@ def test_no_system_is_a_clear_error(ros_system):
     with pytest.raises(norm2tex.Error, match="start: roslaunch norm2tex gripper_sim.launch "
                                              "mode:=synchronous"):
         RosBackend(namespace="/nowhere", service_timeout_s=0.5)
+
+
+def test_the_environment_is_the_same_over_both_backends(backends):
+    """GripperEnv over ROS and in-process: same seeds and actions, the same observations."""
+    from norm2tex.envs import GripperEnv
+
+    over_ros = GripperEnv(backend="ros", noise=False, ros_options={"service_timeout_s": 40.0})
+    in_process = GripperEnv(noise=False)
+    assert over_ros.observation_space.keys() == in_process.observation_space.keys()
+    actions = np.random.default_rng(1).integers(0, 3, size=25)
+    for seed in (1, 2):
+        a, info_a = over_ros.reset(seed=seed)
+        b, info_b = in_process.reset(seed=seed)
+        assert info_a["variant"] == info_b["variant"] and info_a["seed"] == info_b["seed"]
+        for step, action in enumerate(actions):
+            for key in b:
+                assert np.array_equal(a[key], b[key]), (seed, step, key)
+            a, reward_a, done_a, cut_a, info_a = over_ros.step(int(action))
+            b, reward_b, done_b, cut_b, info_b = in_process.step(int(action))
+            assert (reward_a, done_a, cut_a) == (reward_b, done_b, cut_b)
+            assert info_a["finger_opening"] == info_b["finger_opening"]
+    over_ros.close()
+    in_process.close()

@@ -50,7 +50,9 @@ class GripperVectorEnv(spaces.EnvBase):
       scene: config/scenes/<name>.yaml name or a path (the gripper, the object, the episode).
       sensor: a sensor yaml (default config/digit.yaml).
       friction: Coulomb coefficient (None: the material's).
-      noise: image noise on (drawn per episode from its seed) or off.
+      noise: image noise on (drawn per episode from its seed) or off. The sensor adds noise on
+        a synthetic background (or with noise.on_real_background); the default sensor's
+        captured background already carries the real DIGIT's noise and gets none on top.
       action: "discrete" (Discrete(3): 0 close by 0.005, 1 stay, 2 open by 0.005), "delta" (Box
         [-max_delta, max_delta]) or "absolute" (Box [0, 1]): the normalised opening command.
       image: "raw" (uint8 bgr8), "diff_int16" (minus the no-contact frame, int16) or
