@@ -221,3 +221,12 @@ def test_the_environment_is_the_same_over_both_backends(backends):
             assert info_a["finger_opening"] == info_b["finger_opening"]
     over_ros.close()
     in_process.close()
+
+
+def test_an_environment_unlike_the_running_system_is_refused(backends):
+    from norm2tex.envs import GripperEnv, HoldCubeEnv
+
+    with pytest.raises(ValueError, match="scene hold_cube .*launch with scene:="):
+        HoldCubeEnv(backend="ros", ros_options={"service_timeout_s": 40.0})
+    with pytest.raises(ValueError, match="material fabric"):
+        GripperEnv(backend="ros", material="fabric", ros_options={"service_timeout_s": 40.0})

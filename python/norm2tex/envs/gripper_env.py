@@ -134,6 +134,7 @@ class GripperVectorEnv(spaces.EnvBase):
             from norm2tex.envs.ros_backend import RosBackend
 
             self.backend = RosBackend(**(ros_options or {}))
+            self._check_ros_system(scene, sensor, material, beta_mm, friction)
         else:
             raise ValueError("backend = %r; valid: inprocess, ros" % backend)
         if variants is None:
@@ -151,6 +152,37 @@ class GripperVectorEnv(spaces.EnvBase):
         self.single_action_space = self._single_action_space()
         self.observation_space = single_obs if self.num_envs == 1 else None
         self.action_space = self.single_action_space
+
+    def _check_ros_system(self, scene, sensor, material, beta_mm, friction):
+        """The running system decides the scene, sensor and material: refuse an environment
+        that asks for others (it would silently be another task)."""
+        import os
+
+        import norm2tex
+
+        def same(a, b):
+            return os.path.realpath(a) == os.path.realpath(b)
+
+        b = self.backend
+        wrong = []
+        if b.scene and not same(norm2tex.scene_config(scene), b.scene):
+            wrong.append("scene %s (the system's: %s; launch with scene:=%s)"
+                         % (scene, b.scene, norm2tex.scene_config(scene)))
+        if b.mesh:
+            wrong.append("the system simulates its own mesh %s" % b.mesh)
+        if sensor and b.sensor and not same(sensor, b.sensor):
+            wrong.append("sensor %s (the system's: %s)" % (sensor, b.sensor))
+        if (material or "none") != b.material:
+            wrong.append("material %s (the system's: %s; launch with material:=%s)"
+                         % (material, b.material, material or "none"))
+        if beta_mm is not None and abs(beta_mm - b.beta_mm) > 1e-12:
+            wrong.append("beta_mm %g (the system's: %g)" % (beta_mm, b.beta_mm))
+        if friction is not None and abs(friction - b.friction) > 1e-12:
+            wrong.append("friction %g (the system's: %g)" % (friction, b.friction))
+        if wrong:
+            self.backend.close()
+            raise ValueError("backend 'ros': the running gripper_sim.launch differs from this "
+                             "environment: " + "; ".join(wrong))
 
     # --- spaces -----------------------------------------------------------------------------
     def _image_shape(self):

@@ -101,6 +101,9 @@ class RosBackend:
             raise norm2tex.Error("RosBackend: contact_sim's ~renderers %s lacks %s: its ~step would "
                                  "not wait for their images" % (renderers, missing))
         self.material = param("contact_sim/material", "wood") or "none"
+        self.scene = param("contact_sim/scene", "")
+        self.mesh = param("contact_sim/mesh", "")
+        self.sensor = param("contact_sim/sensor", "")
         material = None
         if self.material != "none":
             material = norm2tex.MaterialConfig.load(norm2tex.material_config(self.material))
