@@ -15,11 +15,10 @@ enum class OpeningCommand {
   kDelta,     ///< GripperSim::addOpening(value) (clamped to [0, 1])
 };
 
-/// N TactileGrippers stepped together on a fixed set of threads. With at least as many
-/// grippers as threads, one job per gripper (its physics, then its two sensors); with fewer,
-/// all physics first and then every sensor's render as a job of its own, so that even one
-/// gripper renders its two sensors in parallel. Each gripper gives exactly what it gives alone:
-/// the threads only decide where a gripper's own work runs.
+/// N TactileGrippers stepped together on a fixed set of threads: all physics first (one job
+/// per gripper), then every sensor's render (two jobs per gripper), so that even one gripper
+/// renders its two sensors in parallel. Each gripper gives exactly what it gives alone: the
+/// threads only decide where a gripper's own work runs.
 ///
 /// The grippers share one texture cache: a material variant is generated once for all.
 class TactileGripperBatch {

@@ -62,13 +62,9 @@ void TactileGripperBatch::step(const std::vector<OpeningCommand>& modes,
     if (modes[i] == OpeningCommand::kAbsolute) grippers_[i]->sim().setOpening(values[i]);
     if (modes[i] == OpeningCommand::kDelta) grippers_[i]->sim().addOpening(values[i]);
   }
-  if (static_cast<int>(n) >= pool_.threads()) {
-    // Enough grippers for every thread: one job each, its physics then its two sensors (one
-    // hand-over per gripper, its state still in this core's cache when it renders).
-    pool_.run(static_cast<int>(n), [&](int i) { grippers_[i]->step(frames); });
-    return;
-  }
-  // Fewer grippers than threads: the sensors of one gripper render in parallel.
+  // All physics first, then every sensor as a job of its own: 2N jobs balance the threads
+  // better than N jobs of a whole gripper each (measured: 598-603 vs 578-583 environment
+  // steps/s for a batch of 4 on 2 cores), and even one gripper renders its sensors in parallel.
   pool_.run(static_cast<int>(n), [&](int i) { grippers_[i]->stepPhysics(frames); });
   pool_.run(static_cast<int>(2 * n), [&](int job) {
     grippers_[job / 2]->render(job % 2 == 0 ? Finger::kLeft : Finger::kRight);
