@@ -60,7 +60,8 @@ py::array stackImages(const TactileGripperBatch& batch, Finger finger) {
   const std::size_t bytes = static_cast<std::size_t>(rows * cols * 3);
   for (int i = 0; i < batch.size(); ++i) {
     const cv::Mat3b& image = batch.gripper(i).frame(finger).image;
-    std::memcpy(out.mutable_data(i), image.isContinuous() ? image.data : image.clone().data, bytes);
+    const cv::Mat3b rows = image.isContinuous() ? image : image.clone();  // one block to copy
+    std::memcpy(out.mutable_data(i), rows.data, bytes);
   }
   return out;
 }

@@ -210,3 +210,16 @@ def test_the_readme_python_examples_run():
     assert len(blocks) == 2
     for block in blocks:
         exec(compile(block, "README.md", "exec"), {})
+
+
+def test_a_batch_has_batched_spaces():
+    vector = GripperVectorEnv(num_envs=3, image="diff_int16", downscale=4, noise=False)
+    obs, infos = vector.reset(seed=1)
+    assert vector.observation_space.contains(obs)
+    assert obs["digit_left"].shape == (3, 80, 60, 3) and len(infos) == 3
+    actions = vector.action_space.sample()
+    assert actions.shape == (3,) and vector.action_space.contains(actions)
+    obs, rewards, terminated, truncated, infos = vector.step(actions)
+    assert vector.observation_space.contains(obs)
+    assert rewards.shape == terminated.shape == truncated.shape == (3,)
+    vector.close()

@@ -9,9 +9,11 @@ physics, then both DIGIT images at the last frame. The same environment runs in 
 """
 
 import math
+import os
 
 import numpy as np
 
+import norm2tex
 from norm2tex.envs import spaces
 from norm2tex.envs.inprocess_backend import ABSOLUTE, DELTA, KEEP, InProcessBackend
 
@@ -147,19 +149,17 @@ class GripperVectorEnv(spaces.EnvBase):
         self._episodes = [_Episode() for _ in range(self.num_envs)]
         self._backgrounds = {f: self.backend.background(f) for f in FINGERS}
 
-        single_obs = self._single_observation_space()
-        self.single_observation_space = single_obs
+        self.single_observation_space = self._single_observation_space()
         self.single_action_space = self._single_action_space()
-        self.observation_space = single_obs if self.num_envs == 1 else None
-        self.action_space = self.single_action_space
+        # The batch's spaces: every entry with a first axis of N (actions: one per environment).
+        self.observation_space = spaces.Dict(
+            {k: self._batched(v) for k, v in self.single_observation_space.spaces.items()}
+        )
+        self.action_space = self._batched(self.single_action_space)
 
     def _check_ros_system(self, scene, sensor, material, beta_mm, friction):
         """The running system decides the scene, sensor and material: refuse an environment
         that asks for others (it would silently be another task)."""
-        import os
-
-        import norm2tex
-
         def same(a, b):
             return os.path.realpath(a) == os.path.realpath(b)
 
@@ -209,6 +209,17 @@ class GripperVectorEnv(spaces.EnvBase):
         if self.with_force:
             entries.append(("force", spaces.Box(0.0, np.inf, shape=(2,), dtype=np.float32)))
         return spaces.Dict(dict(entries))
+
+    def _batched(self, space):
+        n = self.num_envs
+        if isinstance(space, spaces.Discrete):
+            return spaces.Box(0, space.n - 1, shape=(n,), dtype=np.int64)
+        return spaces.Box(
+            np.broadcast_to(space.low, (n,) + space.shape),
+            np.broadcast_to(space.high, (n,) + space.shape),
+            shape=(n,) + space.shape,
+            dtype=space.dtype,
+        )
 
     def _single_action_space(self):
         if self.action_kind == "discrete":
@@ -284,6 +295,7 @@ class GripperVectorEnv(spaces.EnvBase):
         command = self._after_reset(i, rng)
         episode.steps = 0
         episode.info = {
+            "start_opening": float(command[1]) if command else float("nan"),
             "episode": int(start["episode"]),
             "seed": sim_seed,
             "variant": int(variant),

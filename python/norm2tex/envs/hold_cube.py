@@ -48,9 +48,7 @@ class HoldCubeVectorEnv(GripperVectorEnv):
                          max_episode_steps=max_episode_steps, **kwargs)
 
     def _after_reset(self, i, rng):
-        start = float(rng.uniform(*START_OPENING))
-        self._episodes[i].info_start_opening = start
-        return (ABSOLUTE, start, self.grasp_frames)
+        return (ABSOLUTE, float(rng.uniform(*START_OPENING)), self.grasp_frames)
 
     def _reward(self, state, i):
         return hold_reward(state["commanded_opening"][i])
