@@ -40,24 +40,25 @@ def config_path(*parts):
     return os.path.join(config_dir(), *parts)
 
 
-def material_config(material):
-    """config/materials/<material>.yaml for a material name; a path (with '/' or '.yaml') is
-    returned as it is. Raises ValueError listing the materials for an unknown name."""
-    if "/" in material or material.endswith(".yaml"):
-        return material
-    path = config_path("materials", material + ".yaml")
+def _named(kind, name, what):
+    """config/<kind>/<name>.yaml for a name; a path (with '/' or '.yaml') is returned as it is.
+    Raises ValueError listing the valid names for an unknown one."""
+    if "/" in name or name.endswith(".yaml"):
+        return name
+    path = config_path(kind, name + ".yaml")
     if not os.path.isfile(path):
-        names = sorted(f[:-5] for f in os.listdir(config_path("materials")) if f.endswith(".yaml"))
-        raise ValueError("unknown material '%s'; valid: %s" % (material, ", ".join(names)))
+        names = sorted(f[:-5] for f in os.listdir(config_path(kind)) if f.endswith(".yaml"))
+        raise ValueError("unknown %s '%s'; valid: %s" % (what, name, ", ".join(names)))
     return path
+
+
+def material_config(material):
+    """config/materials/<material>.yaml for a material name (wood, fabric, rock, smooth, print3d);
+    a path is returned as it is. Raises ValueError listing the materials for an unknown name."""
+    return _named("materials", material, "material")
 
 
 def scene_config(scene):
-    """config/scenes/<scene>.yaml for a scene name (cube, sphere); a path is returned as it is."""
-    if "/" in scene or scene.endswith(".yaml"):
-        return scene
-    path = config_path("scenes", scene + ".yaml")
-    if not os.path.isfile(path):
-        names = sorted(f[:-5] for f in os.listdir(config_path("scenes")) if f.endswith(".yaml"))
-        raise ValueError("unknown scene '%s'; valid: %s" % (scene, ", ".join(names)))
-    return path
+    """config/scenes/<scene>.yaml for a scene name (cube, sphere, hold_cube); a path is returned
+    as it is. Raises ValueError listing the scenes for an unknown name."""
+    return _named("scenes", scene, "scene")
