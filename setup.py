@@ -6,6 +6,6 @@ from catkin_pkg.python_setup import generate_distutils_setup
 
 setup(
     **generate_distutils_setup(
-        packages=["norm2tex", "norm2tex.envs", "norm2tex_dataset"], package_dir={"": "python"}
+        packages=["norm2tex", "norm2tex.envs", "norm2tex.rl", "norm2tex_dataset"], package_dir={"": "python"}
     )
 )

@@ -1,0 +1,1 @@
+"""Reinforcement learning on the environments (PyTorch): a small, readable PPO."""
