@@ -327,6 +327,7 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
   std::string material = params_.material;
   int variant = params_.variant;
   double beta_mm = beta_mm_;
+  std::string next_material;  // announced only with set_texture
   if (request.set_texture) {
     if (!request.material.empty()) material = request.material;
     variant = static_cast<int>(request.variant);
@@ -337,6 +338,14 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
                     std::to_string(request.variant));
       }
       const std::string path = materialConfigPath(material);  // throws for an unknown one
+      if (!request.next_material.empty()) {
+        if (request.next_variant > 100000) {
+          throw Error("next_variant " + std::to_string(request.next_variant) +
+                      " out of range; valid: [0, 100000]");
+        }
+        materialConfigPath(request.next_material);  // an unknown one is refused now
+        next_material = request.next_material;
+      }
       if (material != params_.material && params_.beta < 0.0) {
         beta_mm = loadMaterialConfig(path).beta_mm;  // the label of what the renderers draw
       }
@@ -351,15 +360,21 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
     const std::string old_material = params_.material;
     const int old_variant = params_.variant;
     const double old_beta = beta_mm_;
+    const std::string old_next_material = next_material_;
+    const std::uint32_t old_next_variant = next_variant_;
     params_.material = material;
     params_.variant = variant;
     beta_mm_ = beta_mm;
+    next_material_ = next_material;
+    next_variant_ = next_material.empty() ? 0 : request.next_variant;
     try {
       response.info = startEpisode(request.seed, request.height_offset);
     } catch (const Error&) {
       params_.material = old_material;  // refused: nothing changed
       params_.variant = old_variant;
       beta_mm_ = old_beta;
+      next_material_ = old_next_material;
+      next_variant_ = old_next_variant;
       throw;
     }
     response.grasp_opening = sim_->commandedOpening();
@@ -554,6 +569,8 @@ std::uint32_t ContactSim::publishFrame() {
   frame.acknowledge = acknowledge;
   frame.material = params_.material;
   frame.variant = static_cast<std::uint32_t>(params_.variant);
+  frame.next_material = next_material_;
+  frame.next_variant = next_variant_;
   // Lock-step: every renderer answers this frame before the next one is simulated.
   return lock_step_->publish(frame_pub_, frame);
 }

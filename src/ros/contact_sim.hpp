@@ -116,6 +116,10 @@ class ContactSim {
   std::int64_t anchor_frame_ = 0;
   ros::WallTime tick_;  ///< real time: the scheduled time of the timer tick being handled
   double beta_mm_ = 0.0;
+  /// The texture the next episode will name (a ~reset's next_material/next_variant), announced
+  /// in every frame so the renderers prepare it meanwhile; "" = none.
+  std::string next_material_;
+  std::uint32_t next_variant_ = 0;
   std::uint32_t episode_ = 0;
   EpisodeState episode_state_;  ///< as last published on /episode_state
 

@@ -230,3 +230,45 @@ def test_an_environment_unlike_the_running_system_is_refused(backends):
         HoldCubeEnv(backend="ros", ros_options={"service_timeout_s": 40.0})
     with pytest.raises(ValueError, match="material fabric"):
         GripperEnv(backend="ros", material="fabric", ros_options={"service_timeout_s": 40.0})
+
+
+def test_the_next_variant_is_announced_to_the_renderers(backends):
+    """reset(..., next_variant=v): this episode's frames name v as the next texture (the
+    renderers prepare it meanwhile); a reset without it announces nothing."""
+    import threading
+
+    import rospy
+    from norm2tex.msg import SimFrame
+
+    ros, _ = backends
+    frames = []
+    arrived = threading.Condition()
+
+    def keep(msg):
+        with arrived:
+            frames.append(msg)
+            arrived.notify_all()
+
+    sub = rospy.Subscriber("/contact_sim/frame", SimFrame, keep, queue_size=100)
+    deadline = time.monotonic() + 20.0
+    while sub.get_num_connections() < 1:
+        assert time.monotonic() < deadline, "no connection to /contact_sim/frame"
+        time.sleep(0.01)
+
+    def frame_of(episode):
+        with arrived:
+            ok = arrived.wait_for(lambda: any(f.episode == episode for f in frames),
+                                  timeout=max(deadline - time.monotonic(), 0.1))
+            assert ok, "no frame of episode %d" % episode
+            return [f for f in frames if f.episode == episode][0]
+
+    try:
+        start = ros.reset(0, 21, None, 1, next_variant=7)
+        frame = frame_of(start["episode"])
+        assert (frame.material, frame.variant) == ("wood", 1)
+        assert (frame.next_material, frame.next_variant) == ("wood", 7)
+        start = ros.reset(0, 22, None, 7)
+        frame = frame_of(start["episode"])
+        assert (frame.variant, frame.next_material) == (7, "")
+    finally:
+        sub.unregister()

@@ -29,6 +29,7 @@ class _Episode:
 
     def __init__(self):
         self.rng = np.random.default_rng()
+        self.next_variant = None  # drawn one episode ahead
         self.steps = 0
         self.info = {}
 
@@ -283,15 +284,22 @@ class GripperVectorEnv(spaces.EnvBase):
         episode = self._episodes[i]
         if seed is not None:
             episode.rng = np.random.default_rng(seed)
+            episode.next_variant = None
         rng = episode.rng
         options = options or {}
         sim_seed = int(rng.integers(0, 2**31 - 1))
-        variant = options.get("variant", self.variants[int(rng.integers(len(self.variants)))])
+        # The variant was drawn one episode ahead (so that it could be prepared meanwhile).
+        drawn = episode.next_variant
+        if drawn is None:
+            drawn = self.variants[int(rng.integers(len(self.variants)))]
+        variant = options.get("variant", drawn)
+        episode.next_variant = self.variants[int(rng.integers(len(self.variants)))]
         noise_seed = int(rng.integers(0, 2**31 - 1)) if self.noise else None
         height = options.get("height_offset_m")
         if getattr(self.backend, "noise_per_episode", False):
             self.backend.set_noise_seed(i, noise_seed)
-        start = self.backend.reset(i, sim_seed, height, variant)
+        next_variant = episode.next_variant if len(self.variants) > 1 else None
+        start = self.backend.reset(i, sim_seed, height, variant, next_variant)
         command = self._after_reset(i, rng)
         episode.steps = 0
         episode.info = {

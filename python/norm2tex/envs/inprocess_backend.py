@@ -16,8 +16,9 @@ class InProcessBackend:
 
     Every backend has this interface (RosBackend too, for count 1):
       size, frame_seconds, variant_count
-      reset(i, seed, height_offset_m=None, variant=None) -> dict(episode, seed, height_offset_m,
-                                                                   grasp_opening)
+      reset(i, seed, height_offset_m=None, variant=None, next_variant=None)
+          -> dict(episode, seed, height_offset_m, grasp_opening); next_variant: the texture
+             variant the next episode will use, prepared in the background meanwhile
       set_noise_seed(i, noise_seed)
       step(modes, values, frames=1)      # per gripper: KEEP / ABSOLUTE / DELTA and a value
       step_one(i, mode, value, frames=1)  # gripper i alone (the others stand still)
@@ -81,11 +82,14 @@ class InProcessBackend:
         self.friction = self.batch.friction(0)
         self._backgrounds = {f: self.batch.background(f) for f in ("left", "right")}
 
-    def reset(self, i, seed, height_offset_m=None, variant=None):
+    def reset(self, i, seed, height_offset_m=None, variant=None, next_variant=None):
         offset = None if height_offset_m is None or math.isnan(height_offset_m) else height_offset_m
         if not self.has_material:
-            variant = None  # no texture to vary
-        return self.batch.reset(i, int(seed), offset, -1 if variant is None else int(variant))
+            variant = next_variant = None  # no texture to vary
+        start = self.batch.reset(i, int(seed), offset, -1 if variant is None else int(variant))
+        if next_variant is not None:
+            self.batch.prefetch_variant(int(next_variant))  # generated while this episode runs
+        return start
 
     def prefetch_variant(self, variant):
         self.batch.prefetch_variant(int(variant))

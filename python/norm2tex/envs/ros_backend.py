@@ -215,11 +215,13 @@ class RosBackend:
             "frame": np.array([r.frame], dtype=np.int64),
         }
 
-    def reset(self, i, seed, height_offset_m=None, variant=None):
+    def reset(self, i, seed, height_offset_m=None, variant=None, next_variant=None):
         """Starts an episode (~reset): seed >= 0, offset [m] within height_offset_range (None:
         drawn with the seed), texture variant (None: keep; another than the launch's needs
-        texture_from_frame:=true). Returns dict(episode, seed, height_offset_m, grasp_opening).
-        Raises norm2tex.Error with contact_sim's message when it refuses (nothing changed)."""
+        texture_from_frame:=true), and the variant the next episode will use (None: unknown),
+        which the renderers then prepare during this one. Returns dict(episode, seed,
+        height_offset_m, grasp_opening). Raises norm2tex.Error with contact_sim's message when
+        it refuses (nothing changed)."""
         self._check_index(i)
         request = self._Reset._request_class()
         request.seed = int(seed)
@@ -234,6 +236,12 @@ class RosBackend:
                     "%d; %s" % (int(variant), self.variant, self.START))
             request.set_texture = True
             request.variant = int(variant)
+        if self.has_material and self.texture_from_frame and next_variant is not None:
+            # Announced in this episode's frames: the renderers prepare it in the background.
+            request.set_texture = True
+            request.variant = self.variant if variant is None else int(variant)
+            request.next_material = self.material
+            request.next_variant = int(next_variant)
         r = self._call("_reset_proxy", self._reset_name, self._Reset, request)
         if not r.success:
             raise norm2tex.Error(r.message)
@@ -257,7 +265,7 @@ class RosBackend:
                                                   -1 if wanted is None else wanted))
 
     def prefetch_variant(self, variant):
-        """Nothing: the renderers prepare a variant at the first frame that names it."""
+        """Nothing here: reset(..., next_variant=v) announces it to the renderers."""
 
     def step(self, modes, values, frames=1):
         """One command (KEEP / ABSOLUTE / DELTA and its value) and `frames` sensor frames
