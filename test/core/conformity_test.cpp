@@ -25,9 +25,9 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // (a) A 1-D sinusoid pressed flat.
 
-// The relief Delta cos(2 pi (c + 0.5) / lambda) over 5 whole periods: symmetric about both
-// image edges, so the bands' reflected borders continue it exactly.
-constexpr int kWavelengthPx = 200, kCols = 5 * kWavelengthPx, kRows = 8;
+// The relief Delta cos(2 pi c / lambda) over 5 whole periods, crests on the first and last
+// column: symmetric about both, so the bands' mirrored borders continue it exactly.
+constexpr int kWavelengthPx = 200, kCols = 5 * kWavelengthPx + 1, kRows = 9;
 constexpr double kMmPerPixel = 0.01;  // lambda = 2 mm
 constexpr double kAmplitudeMm = 0.05;
 constexpr double kModulusMpa = 0.1;
@@ -48,7 +48,7 @@ SinusoidPress pressSinusoid(double pressure_ratio) {
   for (int r = 0; r < kRows; ++r) {
     for (int c = 0; c < kCols; ++c) {
       press.relief(r, c) =
-          static_cast<float>(kAmplitudeMm * std::cos(2.0 * CV_PI * (c + 0.5) / kWavelengthPx));
+          static_cast<float>(kAmplitudeMm * std::cos(2.0 * CV_PI * c / kWavelengthPx));
     }
   }
   const cv::Mat1f indentation(kRows, kCols, 0.5f);  // flat: uniform pressure
@@ -58,8 +58,8 @@ SinusoidPress pressSinusoid(double pressure_ratio) {
   options.enabled = true;
   options.contact_modulus_mpa = kModulusMpa;
   GelConformity conformity(options, kMmPerPixel);
-  press.stats = conformity.apply(indentation, press.relief, cv::Rect(0, 0, kCols, kRows), force_n,
-                                 press.followed);
+  press.stats = conformity.apply(indentation, press.relief, 1.0, cv::Rect(0, 0, kCols, kRows),
+                                 force_n, press.followed);
   return press;
 }
 
@@ -87,11 +87,17 @@ TEST(GelConformity, SinusoidIsFollowedFromItsCrestsAsJohnsonSays) {
   // The measured wavelength and p* are the sinusoid's own.
   const SinusoidPress half = pressSinusoid(0.5);
   EXPECT_NEAR(half.stats.relief_amplitude_mm, kAmplitudeMm, 1e-3 * kAmplitudeMm);
+  // Bands holding only a sliver of the sinusoid are folded into the coarser ones (amplitude 0);
+  // the one that holds it sees its wavelength and p*.
+  int bands_holding_it = 0;
   for (const ConformityBand& band : half.stats.bands) {
+    if (band.amplitude_mm == 0.0) continue;
+    ++bands_holding_it;
     EXPECT_NEAR(band.wavelength_mm, kWavelengthPx * kMmPerPixel, 0.01 * kWavelengthPx * kMmPerPixel);
     EXPECT_NEAR(band.full_contact_pressure_mpa, fullContactPressureMpa(),
                 0.01 * fullContactPressureMpa());
   }
+  EXPECT_GE(bands_holding_it, 1);
   // The gel's mean indentation is the physics': clipping the valleys does not raise it.
   for (double ratio : {0.0, 0.3, 0.8}) {
     EXPECT_NEAR(cv::mean(pressSinusoid(ratio).followed)[0], 0.0, 1e-2 * kAmplitudeMm) << ratio;
@@ -130,12 +136,15 @@ TEST(GelConformity, BadInputIsAClearError) {
   cv::Mat1f out;
   GelConformity conformity(options, 0.05);
   const cv::Rect box(0, 0, 4, 4);
-  test::expectError([&] { conformity.apply(field, field, box, -1.0, out); },
+  test::expectError([&] { conformity.apply(field, field, 1.0, box, -1.0, out); },
                     {"normal force", "-1", ">= 0 N"});
   test::expectError(
-      [&] { conformity.apply(field, field, box, std::numeric_limits<double>::quiet_NaN(), out); },
+      [&] {
+        conformity.apply(field, field, 1.0, box, std::numeric_limits<double>::quiet_NaN(), out);
+      },
       {"normal force", "nan"});
-  test::expectError([&] { conformity.apply(field, cv::Mat1f(3, 4, 0.0f), box, 1.0, out); },
+  test::expectError([&] { conformity.apply(field, field, -0.1, box, 1.0, out); }, {"beta"});
+  test::expectError([&] { conformity.apply(field, cv::Mat1f(3, 4, 0.0f), 1.0, box, 1.0, out); },
                     {"differ in size"});
   options.contact_modulus_mpa = 0.0;
   test::expectError([&] { GelConformity bad(options, 0.05); },
@@ -193,7 +202,7 @@ TEST(ConformityRender, FlatFaceShowsMoreTextureTheHarderItIsPressed) {
   const auto box = std::make_shared<const TexturedMesh>(makeBox({0.06, 0.06, 0.01}, 0.02));
   const GelLaw law = GelLaw::taximDefault();
   TactileRenderer textured(conformingSensor()), plain(conformingSensor());
-  textured.setObject(box, randomAtlas(1.0), 0.05);
+  textured.setObject(box, randomAtlas(1.0), 0.1);  // relief +-0.1 mm: p* within 2-12 N
   plain.setObject(box);
   const std::vector<double> forces = {2.0, 5.0, 12.0};
   std::vector<cv::Mat3b> textured_images, plain_images;
@@ -212,8 +221,8 @@ TEST(ConformityRender, FlatFaceShowsMoreTextureTheHarderItIsPressed) {
   for (std::size_t i = 0; i < forces.size(); ++i) {
     rms.push_back(textureRms(textured_images[i], plain_images[i], in_contact_at_all));
   }
-  EXPECT_GT(rms[1], rms[0] * 1.01) << rms[0] << " at 2 N, " << rms[1] << " at 5 N";
-  EXPECT_GT(rms[2], rms[1] * 1.01) << rms[1] << " at 5 N, " << rms[2] << " at 12 N";
+  EXPECT_GT(rms[1], rms[0] * 1.1) << rms[0] << " at 2 N, " << rms[1] << " at 5 N";
+  EXPECT_GT(rms[2], rms[1] * 1.1) << rms[1] << " at 5 N, " << rms[2] << " at 12 N";
 }
 
 TEST(ConformityRender, BallShowsMoreTextureAtItsCentreThanNearItsRim) {

@@ -77,7 +77,6 @@ class TactileRenderer {
   std::optional<TextureOverlay> overlay_;
   std::optional<GelConformity> conformity_;  // set when model.conformity.enabled
   GelLaw gel_law_ = GelLaw::taximDefault();
-  cv::Mat1f relief_;    // beta H_local (mm), written over the covered box
   cv::Mat1f followed_;  // the relief the gel follows (GelConformity), over the covered box
   TactileFrame frame_;
   cv::Mat1f h_final_;

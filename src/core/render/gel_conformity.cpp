@@ -12,20 +12,25 @@
 namespace norm2tex {
 namespace {
 
-constexpr int kBands = 4;
+constexpr int kBands = GelConformity::kBandCount;
 constexpr double kPi = 3.14159265358979323846;
+// The bands' statistics are global over the contact: a thousand samples are plenty, so a
+// large contact is sampled on every 2nd to 8th row and column.
+constexpr long kEnoughSamples = 1000;
+// Bins of a band's values over the contact, for the mean rise of clipping it at a level.
+constexpr int kBins = 256;
+// Entries of the total mean rise as a function of the indentation (an 8-bit look-up).
+constexpr int kRiseEntries = 256;
 
-// Running sums of one band over the statistics region.
+// Running sums of one band over the sampled contact.
 struct BandSums {
   double min = std::numeric_limits<double>::infinity();
   double max = -std::numeric_limits<double>::infinity();
   double sum = 0.0, sum_sq = 0.0;  // of the values
   double slope_sq = 0.0;           // of |grad|^2 (per pixel^2), central differences
   long slope_count = 0;
+  std::array<double, kBins> counts{};
 };
-
-// Bins of a band's values over the contact, for the mean rise of clipping it at a level.
-constexpr int kBins = 256;
 
 }  // namespace
 
@@ -41,32 +46,55 @@ GelConformity::GelConformity(const ConformityOptions& options, double mm_per_pix
   }
 }
 
-ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& relief_mm,
-                                     cv::Rect box, double normal_force_n,
+ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local,
+                                     double beta_mm, cv::Rect box, double normal_force_n,
                                      cv::Mat1f& followed_mm) {
   if (!(std::isfinite(normal_force_n) && normal_force_n >= 0.0)) {
     throw Error("normal force = " + std::to_string(normal_force_n) +
                 " N is not valid; valid: a finite force >= 0 N");
   }
-  if (h_sensor_mm.size() != relief_mm.size()) {
+  if (!(std::isfinite(beta_mm) && beta_mm >= 0.0)) {
+    throw Error("GelConformity: beta = " + std::to_string(beta_mm) + " mm; valid: >= 0 mm");
+  }
+  if (h_sensor_mm.size() != h_local.size()) {
     throw Error("GelConformity: the indentation and the relief differ in size");
   }
-  if (followed_mm.size() != relief_mm.size()) followed_mm = cv::Mat1f::zeros(relief_mm.size());
+  if (followed_mm.size() != h_local.size()) followed_mm = cv::Mat1f::zeros(h_local.size());
   ConformityStats stats;
   stats.normal_force_n = normal_force_n;
-  box &= cv::Rect(0, 0, relief_mm.cols, relief_mm.rows);
+  box &= cv::Rect(0, 0, h_local.cols, h_local.rows);
   if (box.empty()) return stats;
 
-  // The pressure: the force spread in proportion to the indentation (a Winkler foundation).
-  const cv::Mat1f h = h_sensor_mm(box);
+  // 1. The pressure: the force spread in proportion to the indentation (a Winkler foundation).
+  const cv::Mat1f h = h_sensor_mm(box);  // >= 0 (the rasterizer clamps it)
   double indentation_sum = 0.0;
   long contact_pixels = 0;
-  for (int r = 0; r < h.rows; ++r) {
-    const float* row = h.ptr<float>(r);
-    for (int c = 0; c < h.cols; ++c) {
-      if (row[c] > 0.0f) {
-        indentation_sum += row[c];
-        ++contact_pixels;
+  float deepest = 0.0f;
+  {
+    // One pass, in eight lanes the compiler vectorises (a plain float sum it may not reorder).
+    constexpr int kLanes = 8;
+    for (int r = 0; r < h.rows; ++r) {
+      const float* row = h.ptr<float>(r);
+      float sum[kLanes] = {}, top[kLanes] = {};
+      int count[kLanes] = {};
+      int c = 0;
+      for (; c + kLanes <= h.cols; c += kLanes) {
+        for (int j = 0; j < kLanes; ++j) {
+          const float depth = row[c + j];
+          sum[j] += depth;
+          count[j] += depth > 0.0f ? 1 : 0;
+          top[j] = std::max(top[j], depth);
+        }
+      }
+      for (; c < h.cols; ++c) {
+        sum[0] += row[c];
+        count[0] += row[c] > 0.0f ? 1 : 0;
+        top[0] = std::max(top[0], row[c]);
+      }
+      for (int j = 0; j < kLanes; ++j) {
+        indentation_sum += sum[j];
+        contact_pixels += count[j];
+        deepest = std::max(deepest, top[j]);
       }
     }
   }
@@ -77,156 +105,205 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
   const double pressure_per_mm =
       indentation_sum > 0.0 ? normal_force_n / (indentation_sum * pixel_area) : 0.0;
 
-  // The bands: differences of successive Gaussians (each blur continues the previous one).
-  relief_mm(box).copyTo(smoothed_[0]);
-  double previous_sigma_px = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double sigma_px = kBandSigmasMm[i] / mm_per_pixel_;
-    const double step = std::sqrt(sigma_px * sigma_px - previous_sigma_px * previous_sigma_px);
-    cv::GaussianBlur(smoothed_[i], smoothed_[i + 1], cv::Size(), step, step, cv::BORDER_REFLECT);
-    previous_sigma_px = sigma_px;
-  }
-  const auto band = [this](int k, int r, int c) -> float {
-    return k < 3 ? smoothed_[k](r, c) - smoothed_[k + 1](r, c) : smoothed_[3](r, c);
+  // 2. The bands: differences of successive blurs of the relief, a Gaussian pyramid (each
+  //    level the 5-tap binomial and every second pixel), each level expanded back to full
+  //    resolution: cheap, and the bands telescope, summing to the relief exactly.
+  h_local(box).convertTo(smoothed_[0], CV_32F, beta_mm);  // the relief, mm
+  cv::pyrDown(smoothed_[0], half_[0], cv::Size((box.width + 1) / 2, (box.height + 1) / 2),
+              cv::BORDER_DEFAULT);
+  cv::pyrDown(half_[0], half_[1], cv::Size((half_[0].cols + 1) / 2, (half_[0].rows + 1) / 2),
+              cv::BORDER_DEFAULT);
+  // Back up by pyrUp, aligned with pyrDown's grid (a resize would shift each level by a
+  // fraction of its pixel, and the differences would hold that shift, not texture).
+  cv::pyrUp(half_[0], smoothed_[1], box.size(), cv::BORDER_DEFAULT);
+  cv::pyrUp(half_[1], up_, half_[0].size(), cv::BORDER_DEFAULT);
+  cv::pyrUp(up_, smoothed_[2], box.size(), cv::BORDER_DEFAULT);
+  // Band k runs from level fine[k] to level coarse[k] (kBands: nothing, the residual). Every
+  // smoothed_ is continuous and box-sized, so a pixel is one offset into each.
+  const float* level_data[kBands] = {smoothed_[0].ptr<float>(), smoothed_[1].ptr<float>(),
+                                     smoothed_[2].ptr<float>()};
+  std::array<int, kBands> fine{0, 1, 2}, coarse{1, 2, kBands};
+  std::array<bool, kBands> active{true, true, true};
+  const auto bandAt = [&](int k, int offset) -> float {
+    return coarse[k] < kBands ? level_data[fine[k]][offset] - level_data[coarse[k]][offset]
+                              : level_data[fine[k]][offset];
   };
 
-  // Statistics over the contact (over the whole box when only crests touch).
-  std::array<BandSums, kBands> sums;
-  double relief_min = std::numeric_limits<double>::infinity();
-  double relief_max = -relief_min;
-  for (int r = 0; r < box.height; ++r) {
+  // 3. Where to sample the bands' statistics: contact pixels (all of the box when only crests
+  //    touch) on a grid, off the box's border so that each has four neighbours.
+  const bool anywhere = contact_pixels == 0;
+  const long region = anywhere ? long(box.area()) : contact_pixels;
+  const int stride =
+      std::max(1, std::min(8, static_cast<int>(std::sqrt(double(region) / kEnoughSamples))));
+  sample_offsets_.clear();
+  sample_depths_.clear();
+  for (int r = 1; r + 1 < box.height; r += stride) {
     const float* hr = h.ptr<float>(r);
-    for (int c = 0; c < box.width; ++c) {
-      if (contact_pixels > 0 && !(hr[c] > 0.0f)) continue;
-      relief_min = std::min(relief_min, static_cast<double>(smoothed_[0](r, c)));
-      relief_max = std::max(relief_max, static_cast<double>(smoothed_[0](r, c)));
-      const bool interior = r > 0 && c > 0 && r + 1 < box.height && c + 1 < box.width;
-      for (int k = 0; k < kBands; ++k) {
-        const double v = band(k, r, c);
-        BandSums& s = sums[k];
-        s.min = std::min(s.min, v);
-        s.max = std::max(s.max, v);
-        s.sum += v;
-        s.sum_sq += v * v;
-        if (interior) {
-          const double gx = 0.5 * (band(k, r, c + 1) - band(k, r, c - 1));
-          const double gy = 0.5 * (band(k, r + 1, c) - band(k, r - 1, c));
-          s.slope_sq += gx * gx + gy * gy;
-          ++s.slope_count;
-        }
-      }
+    for (int c = 1; c + 1 < box.width; c += stride) {
+      if (!anywhere && !(hr[c] > 0.0f)) continue;
+      sample_offsets_.push_back(r * box.width + c);
+      sample_depths_.push_back(hr[c]);
     }
   }
-  const long region_pixels = contact_pixels > 0 ? contact_pixels : long(box.area());
-  stats.relief_amplitude_mm = 0.5 * (relief_max - relief_min);
+  const long samples = static_cast<long>(sample_offsets_.size());
+  const int* const offsets = sample_offsets_.data();
+  // A band with under 5 % of the relief's RMS is folded into the next coarser one: it holds
+  // no wavelength of its own, only the tail of a neighbour's (a pure sinusoid leaves a sliver
+  // in every band), and its statistics would be the interpolation's, not the texture's.
+  const auto rmsOver = [&](const auto& value) {
+    double sum = 0.0, sum_sq = 0.0;
+    for (long i = 0; i < samples; ++i) {
+      const double v = value(offsets[i]);
+      sum += v;
+      sum_sq += v * v;
+    }
+    const double mean = samples > 0 ? sum / samples : 0.0;
+    return samples > 0 ? std::sqrt(std::max(0.0, sum_sq / samples - mean * mean)) : 0.0;
+  };
+  const double relief_rms = rmsOver([&](int o) { return level_data[0][o]; });
+  for (int k = 0, start = 0; k < kBands; ++k) {
+    fine[k] = start;
+    if (k + 1 < kBands && rmsOver([&](int o) { return bandAt(k, o); }) < 0.05 * relief_rms) {
+      active[k] = false;  // its levels go to band k + 1
+      continue;
+    }
+    start = k + 1;
+  }
+  // Each band's extremes, RMS and RMS slope, then its histogram.
+  std::array<BandSums, kBands> sums;
+  double relief_min = std::numeric_limits<double>::infinity(), relief_max = -relief_min;
+  {
+    const float* relief = smoothed_[0].ptr<float>();
+    for (long i = 0; i < samples; ++i) {
+      relief_min = std::min(relief_min, double(relief[offsets[i]]));
+      relief_max = std::max(relief_max, double(relief[offsets[i]]));
+    }
+  }
+  std::array<double, kBands> bin_width{};
+  for (int k = 0; k < kBands; ++k) {
+    if (!active[k]) continue;
+    const int w = box.width;
+    BandSums& s = sums[k];
+    for (long i = 0; i < samples; ++i) {
+      const int o = offsets[i];
+      const double v = bandAt(k, o);
+      s.min = std::min(s.min, v);
+      s.max = std::max(s.max, v);
+      s.sum += v;
+      s.sum_sq += v * v;
+      const double gx = 0.5 * (bandAt(k, o + 1) - bandAt(k, o - 1));
+      const double gy = 0.5 * (bandAt(k, o + w) - bandAt(k, o - w));
+      s.slope_sq += gx * gx + gy * gy;
+    }
+    s.slope_count = samples;
+    bin_width[k] = std::max(s.max - s.min, 1e-12) / kBins;
+    const double bins_per_mm = 1.0 / bin_width[k];
+    for (long i = 0; i < samples; ++i) {
+      const int bin = static_cast<int>((bandAt(k, offsets[i]) - s.min) * bins_per_mm);
+      s.counts[std::min(std::max(bin, 0), kBins - 1)] += 1.0;
+    }
+  }
+  stats.relief_amplitude_mm = samples > 0 ? 0.5 * (relief_max - relief_min) : 0.0;
 
-  // Per band: the edge level at zero pressure (its crest), and how fast it sinks with pressure.
+  // 4. Per band: Johnson's p*, and its patch-edge level at indentation h,
+  //    level = crest - 2 A p / p* with p = pressure_per_mm h: the band's lowest value at p*,
+  //    and lower still beyond (nothing clipped); -inf for a flat band.
   std::array<float, kBands> crest{}, sink_per_mm{}, full_sink{};
   for (int k = 0; k < kBands; ++k) {
     const BandSums& s = sums[k];
     ConformityBand& out = stats.bands[k];
-    const double mean = s.sum / region_pixels;
-    const double variance = std::max(0.0, s.sum_sq / region_pixels - mean * mean);
-    const double slope_rms = s.slope_count > 0 ? std::sqrt(s.slope_sq / s.slope_count) : 0.0;
+    crest[k] = -std::numeric_limits<float>::infinity();
+    if (samples == 0 || !active[k]) continue;
+    const double mean = s.sum / samples;
+    const double variance = std::max(0.0, s.sum_sq / samples - mean * mean);
+    const double slope_rms = std::sqrt(s.slope_sq / samples);
     out.amplitude_mm = 0.5 * (s.max - s.min);
-    if (!(out.amplitude_mm > 0.0) || !(slope_rms > 0.0) || !(variance > 0.0)) {
-      // A flat band: nothing to clip; it passes unchanged.
-      crest[k] = -std::numeric_limits<float>::infinity();
-      continue;
-    }
+    if (!(out.amplitude_mm > 0.0) || !(slope_rms > 0.0) || !(variance > 0.0)) continue;
     const double wavenumber_per_mm = slope_rms / std::sqrt(variance) / mm_per_pixel_;
     out.wavelength_mm = 2.0 * kPi / wavenumber_per_mm;
     out.full_contact_pressure_mpa =
         kPi * options_.contact_modulus_mpa * stats.relief_amplitude_mm / out.wavelength_mm;
-    // level = crest - 2 A min(1, p / p*), with p = pressure_per_mm * H_sensor.
     crest[k] = static_cast<float>(s.max);
-    full_sink[k] = static_cast<float>(2.0 * out.amplitude_mm);
+    full_sink[k] = static_cast<float>(4.0 * out.amplitude_mm);  // see step 6
     sink_per_mm[k] = static_cast<float>(2.0 * out.amplitude_mm * pressure_per_mm /
                                         out.full_contact_pressure_mpa);
-  }
-  // The depth each band follows, min(1, p / p*), averaged over the contact.
-  if (contact_pixels > 0) {
-    for (int k = 0; k < kBands; ++k) {
-      if (!(stats.bands[k].full_contact_pressure_mpa > 0.0)) continue;
-      double sum = 0.0;
-      const double scale = pressure_per_mm / stats.bands[k].full_contact_pressure_mpa;
-      for (int r = 0; r < h.rows; ++r) {
-        const float* hr = h.ptr<float>(r);
-        for (int c = 0; c < h.cols; ++c) {
-          if (hr[c] > 0.0f) sum += std::min(1.0, scale * hr[c]);
-        }
+    // The depth it follows, min(1, p / p*), averaged over the (sampled) contact.
+    if (!anywhere) {
+      const double ratio_per_mm = pressure_per_mm / out.full_contact_pressure_mpa;
+      double followed = 0.0;
+      for (long i = 0; i < samples; ++i) {
+        followed += std::min(1.0, ratio_per_mm * sample_depths_[i]);
       }
-      stats.bands[k].followed_fraction = sum / contact_pixels;
+      out.followed_fraction = followed / samples;
     }
   }
+  const auto levelAt = [&](int k, float depth) {
+    return crest[k] - std::min(sink_per_mm[k] * depth, full_sink[k]);
+  };
 
-  // Clipping a band at level L raises its mean by rise(L) = mean over the contact of
-  // (L - band)+. The gel's mean indentation is the physics' (the law gives the force for
-  // H_sensor), so each pixel's rise is taken off again: the texture only redistributes the
-  // indentation, and where p = 0 a band sits at its mean. rise(L) from the band's histogram
-  // (exact for any distribution of heights, not only a sinusoid's), tabulated at the bin edges.
-  std::array<std::array<float, kBins + 1>, kBands> rise{};
-  std::array<float, kBands> rise_origin{}, rise_per_mm{};
-  {
-    std::array<std::array<double, kBins>, kBands> counts{};
-    std::array<double, kBands> bin_width{};
-    for (int k = 0; k < kBands; ++k) {
-      bin_width[k] = std::max(sums[k].max - sums[k].min, 1e-12) / kBins;
-    }
-    for (int r = 0; r < box.height; ++r) {
-      const float* hr = h.ptr<float>(r);
-      for (int c = 0; c < box.width; ++c) {
-        if (contact_pixels > 0 && !(hr[c] > 0.0f)) continue;
-        for (int k = 0; k < kBands; ++k) {
-          const int bin = static_cast<int>((band(k, r, c) - sums[k].min) / bin_width[k]);
-          counts[k][std::min(std::max(bin, 0), kBins - 1)] += 1.0;
-        }
-      }
-    }
-    for (int k = 0; k < kBands; ++k) {
-      double below = 0.0, below_sum = 0.0;  // count and sum of the bin centres below edge j
-      for (int j = 0; j <= kBins; ++j) {
-        const double level = sums[k].min + j * bin_width[k];
-        rise[k][j] = static_cast<float>((level * below - below_sum) / region_pixels);
-        if (j < kBins) {
-          below += counts[k][j];
-          below_sum += counts[k][j] * (level + 0.5 * bin_width[k]);
-        }
-      }
-      rise_origin[k] = static_cast<float>(sums[k].min);
-      rise_per_mm[k] = static_cast<float>(1.0 / bin_width[k]);
+  // 5. Clipping a band at level L raises its mean by rise(L) = mean over the contact of
+  //    (L - band)+. The gel's mean indentation is the physics' (the law gives the force for
+  //    H_sensor), so each pixel's rise is taken off again: the texture only redistributes the
+  //    indentation, and where p = 0 a band sits at its mean. rise(L) from the band's histogram
+  //    (right for any distribution of heights, not only a sinusoid's); the levels depend on
+  //    the indentation only, so the rise of all bands is tabulated against it.
+  // Prefix sums over the bins: count and sum of the bin centres below each bin edge.
+  std::array<std::array<double, kBins + 1>, kBands> below_count{}, below_sum{};
+  for (int k = 0; k < kBands; ++k) {
+    for (int j = 0; j < kBins; ++j) {
+      const double centre = sums[k].min + (j + 0.5) * bin_width[k];
+      below_count[k][j + 1] = below_count[k][j] + sums[k].counts[j];
+      below_sum[k][j + 1] = below_sum[k][j] + sums[k].counts[j] * centre;
     }
   }
   const auto riseAt = [&](int k, float level) {
-    const float x = std::min(std::max((level - rise_origin[k]) * rise_per_mm[k], 0.0f),
-                             static_cast<float>(kBins));
-    const int j = std::min(static_cast<int>(x), kBins - 1);
-    return rise[k][j] + (x - j) * (rise[k][j + 1] - rise[k][j]);
+    if (!(level > sums[k].min)) return 0.0;
+    const double edge = std::floor((level - sums[k].min) / bin_width[k] + 0.5);
+    const int j = static_cast<int>(std::min(edge, double(kBins)));  // bins with centre < level
+    return (level * below_count[k][j] - below_sum[k][j]) / samples;
   };
-
-  // The followed relief: every band clipped at its edge level, its mean rise taken off, summed.
-  for (int r = 0; r < box.height; ++r) {
-    const float* hr = h.ptr<float>(r);
-    const float* s0 = smoothed_[0].ptr<float>(r);
-    const float* s1 = smoothed_[1].ptr<float>(r);
-    const float* s2 = smoothed_[2].ptr<float>(r);
-    const float* s3 = smoothed_[3].ptr<float>(r);
-    float* out = followed_mm.ptr<float>(box.y + r) + box.x;
-    for (int c = 0; c < box.width; ++c) {
-      const float indentation = std::max(hr[c], 0.0f);
-      const float values[kBands] = {s0[c] - s1[c], s1[c] - s2[c], s2[c] - s3[c], s3[c]};
-      float total = 0.0f;
-      for (int k = 0; k < kBands; ++k) {
-        if (!(crest[k] > -std::numeric_limits<float>::infinity())) {
-          total += values[k];  // a flat band
-          continue;
-        }
-        const float level = crest[k] - std::min(full_sink[k], sink_per_mm[k] * indentation);
-        total += std::max(values[k], level) - riseAt(k, level);
+  rise_table_.create(1, kRiseEntries);
+  const double depth_step = std::max(double(deepest), 1e-9) / (kRiseEntries - 1);
+  for (int i = 0; i < kRiseEntries; ++i) {
+    double rise = 0.0;
+    for (int k = 0; k < kBands; ++k) {
+      if (crest[k] > -std::numeric_limits<float>::infinity()) {
+        rise += riseAt(k, levelAt(k, static_cast<float>(i * depth_step)));
       }
-      out[c] = total;
+    }
+    rise_table_(0, i) = static_cast<float>(rise);
+  }
+
+  // 6. The followed relief: every band clipped at its edge level, the mean rise taken off.
+  //    Band by band over each row, branch-free, so the compiler vectorises it.
+  for (int r = 0; r < box.height; ++r) {
+    const float* __restrict hr = h.ptr<float>(r);
+    float* __restrict out = followed_mm.ptr<float>(box.y + r) + box.x;
+    std::fill(out, out + box.width, 0.0f);
+    for (int k = 0; k < kBands; ++k) {
+      if (!active[k]) continue;
+      const float* __restrict upper = smoothed_[fine[k]].ptr<float>(r);
+      const float top = crest[k], per_mm = sink_per_mm[k], full = full_sink[k];
+      // Past p* the level keeps sinking below the band's lowest sample (to a whole range below
+      // it): nothing is clipped. min / max only, so the compiler vectorises the loops.
+      if (coarse[k] == kBands) {
+        for (int c = 0; c < box.width; ++c) {
+          const float level = top - std::min(per_mm * hr[c], full);
+          out[c] += std::max(upper[c], level);
+        }
+        continue;
+      }
+      const float* __restrict lower = smoothed_[coarse[k]].ptr<float>(r);
+      for (int c = 0; c < box.width; ++c) {
+        const float level = top - std::min(per_mm * hr[c], full);
+        out[c] += std::max(upper[c] - lower[c], level);
+      }
     }
   }
+  // The rise by indentation, quantised to 256 levels (cv::LUT, vectorised).
+  h.convertTo(depth_levels_, CV_8U, (kRiseEntries - 1) / std::max(double(deepest), 1e-9));
+  cv::LUT(depth_levels_, rise_table_, rise_);
+  cv::subtract(followed_mm(box), rise_, followed_mm(box));
   return stats;
 }
 

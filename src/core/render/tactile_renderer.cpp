@@ -103,15 +103,14 @@ ConformityStats TactileRenderer::applyConformity(std::optional<double> normal_fo
     cv::minMaxLoc(h_sensor(box), nullptr, &deepest_mm);
     force_n = gel_law_.force(deepest_mm * 1e-3);
   }
-  if (relief_.size() != h_sensor.size()) relief_ = cv::Mat1f::zeros(h_sensor.size());
-  frame_.h_local(box).convertTo(relief_(box), CV_32F, overlay_->betaMm());
-  const ConformityStats stats = conformity_->apply(h_sensor, relief_, box, force_n, followed_);
+  const ConformityStats stats =
+      conformity_->apply(h_sensor, frame_.h_local, overlay_->betaMm(), box, force_n, followed_);
   // H_final again, as the overlay computes it, from the followed relief instead of the full one.
   const float thickness = static_cast<float>(model_.gel_thickness_mm);
   for (int r = box.y; r < box.y + box.height; ++r) {
-    const float* gap = frame_.raster.gap_mm.ptr<float>(r);
-    const float* followed = followed_.ptr<float>(r);
-    float* out = h_final_.ptr<float>(r);
+    const float* __restrict gap = frame_.raster.gap_mm.ptr<float>(r);
+    const float* __restrict followed = followed_.ptr<float>(r);
+    float* __restrict out = h_final_.ptr<float>(r);
     for (int c = box.x; c < box.x + box.width; ++c) {
       out[c] = std::min(std::max(followed[c] - gap[c], 0.0f), thickness);
     }
