@@ -130,6 +130,47 @@ TEST(GelConformity, ContactPatchesHaveJohnsonsWidth) {
   }
 }
 
+TEST(GelConformity, BallFollowsMoreTextureAtItsCentreThanAtItsRim) {
+  // A 10 mm ball pressed 0.5 mm (a paraboloid of indentation) with the gel law's 4.7 N on a
+  // smooth random relief of +-0.1 mm: the Winkler pressure falls from the centre to 0 at the
+  // rim, so the share of the relief the gel follows (its RMS over the relief's) falls too.
+  const double mm_per_pixel = 0.054, radius_mm = 5.0, press_mm = 0.5;
+  const int size = 121;
+  cv::Mat1f relief(size, size), indentation(size, size);
+  cv::RNG rng(7);
+  rng.fill(relief, cv::RNG::UNIFORM, -1.0, 1.0);
+  cv::GaussianBlur(relief, relief, cv::Size(), 1.5, 1.5);
+  cv::normalize(relief, relief, -0.1, 0.1, cv::NORM_MINMAX);
+  const double contact_radius_mm = std::sqrt(2.0 * radius_mm * press_mm);
+  cv::Mat1b centre = cv::Mat1b::zeros(size, size), rim = centre.clone();
+  for (int r = 0; r < size; ++r) {
+    for (int c = 0; c < size; ++c) {
+      const double d_mm = std::hypot(r - size / 2, c - size / 2) * mm_per_pixel;
+      indentation(r, c) = static_cast<float>(std::max(0.0, press_mm - d_mm * d_mm / (2 * radius_mm)));
+      const double d = d_mm / contact_radius_mm;
+      if (d < 0.5) centre(r, c) = 255;
+      if (d > 0.8 && d < 0.97) rim(r, c) = 255;
+    }
+  }
+  const double force_n = GelLaw::taximDefault().force(press_mm * 1e-3);
+  for (double modulus : {0.1, 1.0}) {
+    ConformityOptions options;
+    options.enabled = true;
+    options.contact_modulus_mpa = modulus;
+    GelConformity conformity(options, mm_per_pixel);
+    cv::Mat1f followed;
+    conformity.apply(indentation, relief, 1.0, cv::Rect(0, 0, size, size), force_n, followed);
+    const double share_centre =
+        test::maskedStdDev(followed, centre) / test::maskedStdDev(relief, centre);
+    const double share_rim = test::maskedStdDev(followed, rim) / test::maskedStdDev(relief, rim);
+    // At 0.1 MPa (the default) the ball's pressure exceeds p* over most of the rim band too;
+    // a stiffer gel's p* lies between the centre's pressure and the rim's.
+    EXPECT_GT(share_centre, share_rim * (modulus < 0.5 ? 1.005 : 1.2))
+        << "E* " << modulus << " MPa: centre " << share_centre << ", rim " << share_rim;
+    EXPECT_LE(share_centre, 1.0 + 1e-3);
+  }
+}
+
 TEST(GelConformity, BadInputIsAClearError) {
   ConformityOptions options;
   const cv::Mat1f field(4, 4, 0.1f);
@@ -259,12 +300,14 @@ TEST(ConformityRender, BallShowsMoreTextureAtItsCentreThanNearItsRim) {
   EXPECT_GT(ratio_default, 1.0) << "centre / rim texture RMS with conformity";
   EXPECT_GE(ratio_default, 0.99 * ratio_off);
   // A stiffer gel (E* 1 MPa), whose p* the ball's pressure spans from centre to rim: the
-  // conformity itself makes the centre show more texture than the rim.
+  // conformity itself adds to the centre's lead. (In the image the rim band also holds the
+  // gel model's core edge, at 0.77 of the radius for a ball, which flips with any texture at
+  // all; the model-level test above shows the effect without it.)
   SensorModel stiff = conformingSensor();
   stiff.conformity.contact_modulus_mpa = 1.0;
   const double ratio_stiff = centreToRimRatio(stiff);
-  EXPECT_GT(ratio_stiff, 1.1 * ratio_off) << "with conformity (E* 1 MPa) " << ratio_stiff
-                                          << ", without " << ratio_off;
+  EXPECT_GT(ratio_stiff, 1.05 * ratio_off) << "with conformity (E* 1 MPa) " << ratio_stiff
+                                           << ", without " << ratio_off;
 }
 
 TEST(ConformityRender, OffIsTheFixedDepthOverlayBitForBit) {

@@ -11,7 +11,7 @@ namespace norm2tex {
 
 /// One wavelength band of the texture in one contact, as GelConformity saw it.
 struct ConformityBand {
-  double wavelength_mm = 0.0;  ///< the band's dominant wavelength (from its RMS slope / RMS)
+  double wavelength_mm = 0.0;  ///< the band's dominant wavelength (RMS step / RMS)
   double amplitude_mm = 0.0;   ///< half its peak-to-valley inside the contact
   double full_contact_pressure_mpa = 0.0;  ///< Johnson's p* = pi E* Delta / lambda
   double followed_fraction = 0.0;  ///< mean over the contact of min(1, p / p*): depth followed
@@ -43,8 +43,8 @@ struct ConformityStats {
 /// a Gaussian pyramid (levels of 2 and 4 pixels: at QVGA wavelengths below about 0.25 mm,
 /// 0.25-0.5 mm and above), each band is clipped at its own patch-edge level with its own
 /// p*_k = pi E* Delta / lambda_k, and the bands are summed again. lambda_k is the band's
-/// dominant wavelength (2 pi RMS / RMS slope, exact for a sinusoid); Delta is the whole
-/// relief's amplitude, since it is the whole relief the gel must reach into at that
+/// dominant wavelength (from its RMS step between pixels, exact for a sinusoid); Delta is the
+/// whole relief's amplitude, since it is the whole relief the gel must reach into at that
 /// wavelength. A band with under 5 % of the relief's RMS is folded into the next coarser one.
 /// Clipping raises a band's mean; that rise is taken off again (from the band's histogram), so
 /// the gel's mean indentation stays the one the physics' force-indentation law gave.

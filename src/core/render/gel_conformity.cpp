@@ -27,8 +27,7 @@ struct BandSums {
   double min = std::numeric_limits<double>::infinity();
   double max = -std::numeric_limits<double>::infinity();
   double sum = 0.0, sum_sq = 0.0;  // of the values
-  double slope_sq = 0.0;           // of |grad|^2 (per pixel^2), central differences
-  long slope_count = 0;
+  double step_sq_x = 0.0, step_sq_y = 0.0;  // of the squared steps to the next pixel in x, y
   std::array<double, kBins> counts{};
 };
 
@@ -130,7 +129,7 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
   };
 
   // 3. Where to sample the bands' statistics: contact pixels (all of the box when only crests
-  //    touch) on a grid, off the box's border so that each has four neighbours.
+  //    touch) on a grid, off the box's border so that each has its neighbours.
   const bool anywhere = contact_pixels == 0;
   const long region = anywhere ? long(box.area()) : contact_pixels;
   const int stride =
@@ -191,11 +190,10 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
       s.max = std::max(s.max, v);
       s.sum += v;
       s.sum_sq += v * v;
-      const double gx = 0.5 * (bandAt(k, o + 1) - bandAt(k, o - 1));
-      const double gy = 0.5 * (bandAt(k, o + w) - bandAt(k, o - w));
-      s.slope_sq += gx * gx + gy * gy;
+      const double dx = bandAt(k, o + 1) - v, dy = bandAt(k, o + w) - v;
+      s.step_sq_x += dx * dx;
+      s.step_sq_y += dy * dy;
     }
-    s.slope_count = samples;
     bin_width[k] = std::max(s.max - s.min, 1e-12) / kBins;
     const double bins_per_mm = 1.0 / bin_width[k];
     for (long i = 0; i < samples; ++i) {
@@ -216,10 +214,18 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
     if (samples == 0 || !active[k]) continue;
     const double mean = s.sum / samples;
     const double variance = std::max(0.0, s.sum_sq / samples - mean * mean);
-    const double slope_rms = std::sqrt(s.slope_sq / samples);
     out.amplitude_mm = 0.5 * (s.max - s.min);
-    if (!(out.amplitude_mm > 0.0) || !(slope_rms > 0.0) || !(variance > 0.0)) continue;
-    const double wavenumber_per_mm = slope_rms / std::sqrt(variance) / mm_per_pixel_;
+    if (!(out.amplitude_mm > 0.0) || !(variance > 0.0)) continue;
+    // The dominant wavenumber from the RMS step to the next pixel: a sinusoid of wavenumber w
+    // (per pixel) steps by 2 sin(w / 2) times its RMS, inverted exactly per axis (a central
+    // difference's sin(w) / w would make the finest band's wavelength up to 1.7x too long).
+    const auto wavenumberAlong = [&](double step_sq) {
+      const double ratio = std::sqrt(step_sq / samples / variance);
+      return 2.0 * std::asin(std::min(1.0, 0.5 * ratio));
+    };
+    const double wx = wavenumberAlong(s.step_sq_x), wy = wavenumberAlong(s.step_sq_y);
+    const double wavenumber_per_mm = std::sqrt(wx * wx + wy * wy) / mm_per_pixel_;
+    if (!(wavenumber_per_mm > 0.0)) continue;
     out.wavelength_mm = 2.0 * kPi / wavenumber_per_mm;
     out.full_contact_pressure_mpa =
         kPi * options_.contact_modulus_mpa * stats.relief_amplitude_mm / out.wavelength_mm;
