@@ -168,7 +168,7 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
     }
     start = k + 1;
   }
-  // Each band's extremes, RMS and RMS slope, then its histogram.
+  // Each band's extremes, RMS and RMS step to the next pixel, then its histogram.
   std::array<BandSums, kBands> sums;
   double relief_min = std::numeric_limits<double>::infinity(), relief_max = -relief_min;
   {
