@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -30,7 +31,7 @@ constexpr const char* kUsage =
     "usage: norm2tex_render --mesh M --pose \"x y z roll pitch yaw\" [--press-mm D]\n"
     "                       [--normal-map N.png | --atlas H.tiff] [--beta MM] [--scale S]\n"
     "                       [--material NAME] [--sensor digit.yaml] [--background BG.png]\n"
-    "                       [--seed S] [--no-noise]\n"
+    "                       [--seed S] [--no-noise] [--force-n F] [--conformity on|off]\n"
     "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
     "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
     "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png\n"
@@ -49,6 +50,11 @@ constexpr const char* kUsage =
     "  --beta: texture depth in mm (default: the material's; 1, a gain, for the mesh's own\n"
     "          texture, baked in mm from the mesh's UV scale; else 0.2 mm; 0 = textureless,\n"
     "          nothing is baked).\n"
+    "  --force-n F: the press's normal force, N (>= 0): how much of the texture the gel\n"
+    "          follows when the sensor's conformity is on; default: the gel law's force for\n"
+    "          the deepest indentation (the scenes' default law).\n"
+    "  --conformity on|off: overrides the sensor yaml's conformity.enabled (off: the paper's\n"
+    "          fixed-depth texture overlay).\n"
     "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
     "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
     "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
@@ -169,7 +175,8 @@ int run(int argc, char** argv) {
   const norm2tex::cli::Arguments args(
       argc, argv,
       {"--mesh", "--pose", "--press-mm", "--normal-map", "--atlas", "--beta", "--scale", "--sensor",
-       "--background", "--seed", "-o", "--depth-out", "--mask-out", "--presses", "--material"},
+       "--background", "--seed", "-o", "--depth-out", "--mask-out", "--presses", "--material",
+       "--force-n", "--conformity"},
       {"--no-noise", "--sheet", "-h", "--help"});
   if (args.flag("-h") || args.flag("--help")) {
     std::cout << kUsage;
@@ -198,6 +205,14 @@ int run(int argc, char** argv) {
                                     ? norm2tex::loadSensorModel(*args.value("--sensor"))
                                     : norm2tex::makeDigitSensorModel();
   if (const auto background = args.value("--background")) model.background_image = *background;
+  if (const auto conformity = args.value("--conformity")) {
+    if (*conformity != "on" && *conformity != "off") {
+      throw norm2tex::cli::UsageError("--conformity: '" + *conformity + "'; valid: on, off");
+    }
+    model.conformity.enabled = *conformity == "on";
+  }
+  std::optional<double> force_n;
+  if (args.has("--force-n")) force_n = args.number("--force-n", 0.0);
   const auto pose = parsePose(*args.value("--pose"), args.number("--press-mm", 0.0));
   std::shared_ptr<const norm2tex::TexturedMesh> mesh = [&] {
     const norm2tex::cli::QuietStderr quiet_decoders;
@@ -241,7 +256,7 @@ int run(int argc, char** argv) {
   const std::int64_t seed = args.flag("--no-noise") ? -1 : args.integer("--seed", 0);
 
   const auto start = std::chrono::steady_clock::now();
-  const norm2tex::TactileFrame& frame = renderer.render(pose, seed);
+  const norm2tex::TactileFrame& frame = renderer.render(pose, seed, force_n);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
@@ -259,6 +274,15 @@ int run(int argc, char** argv) {
   }
   std::printf("%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
               cv::countNonZero(frame.contact_mask), texture, frame.raster.triangles_rasterized, ms);
+  if (frame.conformity) {
+    const norm2tex::ConformityStats& c = *frame.conformity;
+    std::printf("conformity: %.3g N over %.3g mm^2 (mean %.4g MPa); depth followed per band",
+                c.normal_force_n, c.contact_area_mm2, c.mean_pressure_mpa);
+    for (const norm2tex::ConformityBand& band : c.bands) {
+      std::printf(" %.2f (lambda %.3g mm)", band.followed_fraction, band.wavelength_mm);
+    }
+    std::printf("\n");
+  }
   return 0;
 }
 

@@ -147,6 +147,32 @@ TEST_F(RenderCli, BetaZeroBakesNothing) {
   EXPECT_GT(cv::norm(cv::imread(path("textured.png")), plain_image, cv::NORM_L1), 0.0);
 }
 
+TEST_F(RenderCli, ForceSetsTheTextureOnlyWithConformityOn) {
+  const std::string textured =
+      std::string(kBall) + " --normal-map " + path("ridges.png") + " --beta 0.1 --no-noise";
+  const auto image = [&](const std::string& options, const std::string& name) {
+    const CliRun run = render(textured + " " + options + " -o " + path(name));
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return cv::imread(path(name));
+  };
+  // Off (the default sensor): the force changes nothing, bit for bit.
+  const cv::Mat off = image("", "off.png");
+  EXPECT_EQ(cv::norm(off, image("--force-n 0.2", "off_light.png"), cv::NORM_INF), 0.0);
+  // On: a light and a firm force give different frames, and the tool reports the model.
+  const CliRun on = render(textured + " --conformity on --force-n 0.2 -o " + path("light.png"));
+  ASSERT_EQ(on.exit_code, 0) << on.output;
+  EXPECT_NE(on.output.find("conformity: 0.2 N"), std::string::npos) << on.output;
+  EXPECT_GT(cv::norm(cv::imread(path("light.png")), image("--conformity on --force-n 50", "firm.png"),
+                     cv::NORM_L1),
+            0.0);
+  // Bad force or switch: a one-line error, a usage error.
+  const CliRun negative = render(textured + " --conformity on --force-n -1 -o " + path("x.png"));
+  EXPECT_EQ(negative.exit_code, 1) << negative.output;
+  EXPECT_NE(negative.output.find("normal force"), std::string::npos) << negative.output;
+  EXPECT_EQ(render(textured + " --conformity maybe -o " + path("x.png")).exit_code, 2);
+  EXPECT_FALSE(fs::exists(path("x.png")));
+}
+
 TEST_F(RenderCli, BadInputIsAOneLineErrorOrUsage) {
   const CliRun missing =
       render("--mesh " + path("nope.obj") + " --pose \"0 0 0 0 0 0\" -o " + path("x.png"));

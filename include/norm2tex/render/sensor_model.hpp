@@ -60,6 +60,17 @@ struct GelOptions {
   double final_sigma_mm = 0.1;  ///< last blur over everything
 };
 
+/// Pressure-dependent conformity of the gel to the texture (GelConformity, docs/sensor.md).
+/// Off: the paper's fixed-depth overlay, H_final = H_sensor + beta H_local wherever the object
+/// touches, whatever the force.
+struct ConformityOptions {
+  bool enabled = false;
+  /// The gel's contact modulus E* = E / (1 - nu^2), MPa: the default gel law (Taxim-robot's
+  /// GelSight table) read as a flat face pressing the gel pad, E = F h / (A d), gives
+  /// 0.05-0.16 MPa over 0.1-2 mm of indentation (0.08-0.10 over the measured 0.4-0.58 mm).
+  double contact_modulus_mpa = 0.1;
+};
+
 /// Everything about one DIGIT that the renderer needs, loaded from config/digit.yaml.
 ///
 /// Gel frame (shared by the CLI, the tests and the ROS nodes): origin at the centre of the
@@ -87,6 +98,7 @@ struct SensorModel {
   NoiseOptions noise;
   std::string background_image;  ///< user's no-contact frame (BGR); empty = synthetic
   GelOptions gel;
+  ConformityOptions conformity;
 
   /// The imaged part of the gel (cols x mm_per_pixel by rows x mm_per_pixel).
   double gelWidthMm() const { return cols * mm_per_pixel; }

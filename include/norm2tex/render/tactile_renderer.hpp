@@ -10,11 +10,13 @@
 
 #include "norm2tex/render/contact_rasterizer.hpp"
 #include "norm2tex/render/digit_shader.hpp"
+#include "norm2tex/render/gel_conformity.hpp"
 #include "norm2tex/render/gel_model.hpp"
 #include "norm2tex/texture/height_atlas.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/render/texture_overlay.hpp"
 #include "norm2tex/mesh/textured_mesh.hpp"
+#include "norm2tex/sim/gel_law.hpp"
 
 namespace norm2tex {
 
@@ -26,6 +28,8 @@ struct TactileFrame {
   ContactRaster raster;    ///< H_sensor, UVs, faces
   cv::Mat1f h_local;       ///< H_local where textured, else empty
   bool textured = false;   ///< whether the overlay ran
+  /// What the conformity model computed (set when it ran: conformity on and textured).
+  std::optional<ConformityStats> conformity;
 
   /// gel_mm in metres (32FC1), as published on the depth topic.
   cv::Mat1f depthMetres() const;
@@ -46,19 +50,34 @@ class TactileRenderer {
                         std::shared_ptr<const HeightAtlas> atlas = nullptr, double beta_mm = 0.0);
 
   /// Renders the object at `object_in_gel` (metres, gel frame). `noise_seed` < 0: no noise.
-  /// Throws Error for a non-finite pose or when no object was set.
-  const TactileFrame& render(const Eigen::Isometry3d& object_in_gel, std::int64_t noise_seed);
+  /// `normal_force_n`: the contact's normal force (N), which sets how much of the texture the
+  /// gel follows when the model's conformity is on; without it, the gel law's force for the
+  /// deepest indentation. Throws Error for a non-finite pose, a negative or non-finite force,
+  /// or when no object was set.
+  const TactileFrame& render(const Eigen::Isometry3d& object_in_gel, std::int64_t noise_seed,
+                             std::optional<double> normal_force_n = std::nullopt);
+
+  /// The force-indentation law that gives the force of a press when render() is given none
+  /// (default: GelLaw::taximDefault(), the scenes' default law).
+  void setGelLaw(GelLaw law) { gel_law_ = std::move(law); }
+  const GelLaw& gelLaw() const { return gel_law_; }
 
   const SensorModel& model() const { return model_; }
   const DigitShader& shader() const { return shader_; }
 
  private:
+  // GelConformity on the overlay's relief; rewrites h_final_ over the covered box.
+  ConformityStats applyConformity(std::optional<double> normal_force_n);
+
   SensorModel model_;
   ContactRasterizer rasterizer_;
   GelModel gel_;
   DigitShader shader_;
   std::shared_ptr<const TexturedMesh> mesh_;
   std::optional<TextureOverlay> overlay_;
+  std::optional<GelConformity> conformity_;  // set when model.conformity.enabled
+  GelLaw gel_law_ = GelLaw::taximDefault();
+  cv::Mat1f followed_;  // the relief the gel follows (GelConformity), over the covered box
   TactileFrame frame_;
   cv::Mat1f h_final_;
   cv::Rect overlay_box_;  // what the overlay wrote last frame

@@ -35,7 +35,7 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
   static const std::map<std::string, std::set<std::string>> keys = {
       {"",
        {"preset", "image", "gel", "camera", "leds", "shading", "noise", "background_image",
-        "gel_model"}},
+        "gel_model", "conformity"}},
       {"image", {"rows", "cols", "mm_per_pixel"}},
       {"gel", {"thickness_mm", "curvature_radius_mm", "pad_width_mm", "pad_height_mm"}},
       {"camera", {"fx", "fy", "cx", "cy"}},
@@ -46,6 +46,7 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
        {"sigma_bgr", "neighbour_correlation", "correlation_bg", "correlation_gr", "correlation_br",
         "on_real_background"}},
       {"gel_model", {"pyramid_sigmas_mm", "core_fraction", "final_sigma_mm"}},
+      {"conformity", {"enabled", "contact_modulus_mpa"}},
   };
   return keys.at(section);
 }
@@ -214,6 +215,9 @@ void validate(const SensorModel& m) {
     requireParameter(sigma > 0.0 && sigma <= 20.0, "gel_model.pyramid_sigmas_mm", sigma,
                      "(0, 20] mm each");
   }
+  requireParameter(m.conformity.contact_modulus_mpa > 0.0 && m.conformity.contact_modulus_mpa <= 100.0,
+                   "conformity.contact_modulus_mpa", m.conformity.contact_modulus_mpa,
+                   "(0, 100] MPa");
 }
 
 SensorModel loadSensorModel(const std::string& yaml_path) {
@@ -266,6 +270,11 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
       read(gel, "pyramid_sigmas_mm", m.gel.pyramid_sigmas_mm);
       read(gel, "core_fraction", m.gel.core_fraction);
       read(gel, "final_sigma_mm", m.gel.final_sigma_mm);
+    }
+    if (const YAML::Node conformity = root["conformity"]) {
+      rejectUnknownKeys(conformity, "conformity");
+      read(conformity, "enabled", m.conformity.enabled);
+      read(conformity, "contact_modulus_mpa", m.conformity.contact_modulus_mpa);
     }
     if (!m.background_image.empty() && std::filesystem::path(m.background_image).is_relative()) {
       m.background_image =
@@ -332,7 +341,9 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
     out << (i ? ", " : "") << m.gel.pyramid_sigmas_mm[i];
   }
   out << "]\n  core_fraction: " << m.gel.core_fraction
-      << "\n  final_sigma_mm: " << m.gel.final_sigma_mm << "\n";
+      << "\n  final_sigma_mm: " << m.gel.final_sigma_mm << "\n"
+      << "conformity:\n  enabled: " << (m.conformity.enabled ? "true" : "false")
+      << "\n  contact_modulus_mpa: " << m.conformity.contact_modulus_mpa << "\n";
   std::ofstream file(yaml_path);
   file << out.str();
   file.close();

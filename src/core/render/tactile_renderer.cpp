@@ -1,5 +1,9 @@
 #include "norm2tex/render/tactile_renderer.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -29,7 +33,9 @@ TactileRenderer::TactileRenderer(const SensorModel& model, cv::Mat3b background,
     : model_(model),
       rasterizer_(model),
       gel_(model),
-      shader_(model, std::move(background), source) {}
+      shader_(model, std::move(background), source) {
+  if (model_.conformity.enabled) conformity_.emplace(model_.conformity, model_.mm_per_pixel);
+}
 
 std::string TactileRenderer::setObject(std::shared_ptr<const TexturedMesh> mesh,
                                        std::shared_ptr<const HeightAtlas> atlas, double beta_mm) {
@@ -50,8 +56,13 @@ std::string TactileRenderer::setObject(std::shared_ptr<const TexturedMesh> mesh,
 }
 
 const TactileFrame& TactileRenderer::render(const Eigen::Isometry3d& object_in_gel,
-                                            std::int64_t noise_seed) {
+                                            std::int64_t noise_seed,
+                                            std::optional<double> normal_force_n) {
   if (!mesh_) throw Error("TactileRenderer::render: no object set");
+  if (normal_force_n && !(std::isfinite(*normal_force_n) && *normal_force_n >= 0.0)) {
+    throw Error("TactileRenderer::render: normal force = " + std::to_string(*normal_force_n) +
+                " N is not valid; valid: a finite force >= 0 N");
+  }
   const bool textured = overlay_.has_value() && mesh_->hasUvs();
   rasterizer_.rasterize(*mesh_, object_in_gel, textured ? overlay_->reachMm() : 0.0, textured,
                         frame_.raster);
@@ -65,16 +76,46 @@ const TactileFrame& TactileRenderer::render(const Eigen::Isometry3d& object_in_g
     overlay_->apply(frame_.raster, model_.gel_thickness_mm, h_final_, &frame_.h_local);
     overlay_box_ = frame_.raster.covered_box;
     h_final = &h_final_;
+    frame_.conformity.reset();
+    if (conformity_) frame_.conformity = applyConformity(normal_force_n);
   } else {
     frame_.h_local.release();
     h_final_.release();
     overlay_box_ = cv::Rect();
+    frame_.conformity.reset();
   }
   frame_.textured = textured;
   cv::compare(*h_final, 0.0f, frame_.contact_mask, cv::CMP_GT);
   gel_.apply(*h_final, frame_.gel_mm);
   frame_.image = shader_.shade(frame_.gel_mm, noise_seed);
   return frame_;
+}
+
+ConformityStats TactileRenderer::applyConformity(std::optional<double> normal_force_n) {
+  const cv::Rect box = frame_.raster.covered_box;
+  const cv::Mat1f& h_sensor = frame_.raster.h_sensor_mm;
+  if (box.empty()) return ConformityStats{};
+  double force_n = 0.0;
+  if (normal_force_n) {
+    force_n = *normal_force_n;
+  } else {
+    double deepest_mm = 0.0;
+    cv::minMaxLoc(h_sensor(box), nullptr, &deepest_mm);
+    force_n = gel_law_.force(deepest_mm * 1e-3);
+  }
+  const ConformityStats stats =
+      conformity_->apply(h_sensor, frame_.h_local, overlay_->betaMm(), box, force_n, followed_);
+  // H_final again, as the overlay computes it, from the followed relief instead of the full one.
+  const float thickness = static_cast<float>(model_.gel_thickness_mm);
+  for (int r = box.y; r < box.y + box.height; ++r) {
+    const float* __restrict gap = frame_.raster.gap_mm.ptr<float>(r);
+    const float* __restrict followed = followed_.ptr<float>(r);
+    float* __restrict out = h_final_.ptr<float>(r);
+    for (int c = box.x; c < box.x + box.width; ++c) {
+      out[c] = std::min(std::max(followed[c] - gap[c], 0.0f), thickness);
+    }
+  }
+  return stats;
 }
 
 }  // namespace norm2tex

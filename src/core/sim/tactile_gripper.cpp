@@ -160,7 +160,10 @@ void TactileGripper::render(Finger finger) {
   const std::int64_t frame =
       options_.noise_per_episode ? frameIndex() - episode_first_frame_ : frameIndex();
   const std::int64_t noise_seed = options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
-  frames_[index(finger)] = &renderers_[index(finger)]->render(objectInGel(finger), noise_seed);
+  // The gel's normal force from the physics: it sets how much of the texture the gel follows
+  // (GelConformity) when the sensor's conformity is on.
+  frames_[index(finger)] = &renderers_[index(finger)]->render(
+      objectInGel(finger), noise_seed, sim_->contact(finger).normal_force_n);
 }
 
 Eigen::Isometry3d TactileGripper::objectInGel(Finger finger) const {

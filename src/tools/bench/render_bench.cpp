@@ -7,6 +7,7 @@
 
 #include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/render/contact_rasterizer.hpp"
+#include "norm2tex/render/gel_conformity.hpp"
 #include "norm2tex/render/gel_model.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
@@ -46,8 +47,10 @@ std::shared_ptr<const norm2tex::HeightAtlas> atlas() {
 
 void renderLoop(benchmark::State& state, std::shared_ptr<const norm2tex::TexturedMesh> mesh,
                 double beta_mm, std::int64_t seed, bool at_pole = false,
-                const Eigen::Isometry3d* pose_override = nullptr) {
-  norm2tex::TactileRenderer renderer(norm2tex::makeDigitSensorModel());
+                const Eigen::Isometry3d* pose_override = nullptr, bool conformity = false) {
+  norm2tex::SensorModel model = norm2tex::makeDigitSensorModel();
+  model.conformity.enabled = conformity;
+  norm2tex::TactileRenderer renderer(model);
   renderer.setObject(std::move(mesh), beta_mm > 0 ? atlas() : nullptr, beta_mm);
   const Eigen::Isometry3d pose = pose_override ? *pose_override : pressedSphere(at_pole);
   int frame = 0;
@@ -87,6 +90,12 @@ void BM_Render_Textured_HeldCube(benchmark::State& state) {
   renderLoop(state, cube(), 0.2, state.range(1) != 0 ? 1 : -1, false, &pose);
 }
 
+// The held cube with the gel's conformity to the texture on (its force from the gel law).
+void BM_Render_Textured_HeldCube_Conformity(benchmark::State& state) {
+  const Eigen::Isometry3d pose = heldCubePose();
+  renderLoop(state, cube(), 0.2, -1, false, &pose, true);
+}
+
 // --- stages ---------------------------------------------------------------------------------
 // Argument "cube": 0 = the pressed sphere, 1 = the held cube (contact over 3/4 of the gel).
 struct StageFixture {
@@ -122,6 +131,20 @@ void BM_Stage_Gel(benchmark::State& state) {
   StageFixture f(state.range(0) != 0);
   for (auto _ : state) f.gel.apply(f.h_final, f.gel_mm);
 }
+// GelConformity alone (5 N; the renderer adds H_final's rewrite).
+void BM_Stage_Conformity(benchmark::State& state) {
+  StageFixture f(state.range(0) != 0);
+  norm2tex::ConformityOptions options;
+  options.enabled = true;
+  norm2tex::GelConformity conformity(options, f.model.mm_per_pixel);
+  cv::Mat1f h_local, followed;
+  f.overlay.apply(f.raster, f.model.gel_thickness_mm, f.h_final, &h_local);
+  for (auto _ : state) {
+    const norm2tex::ConformityStats stats = conformity.apply(
+        f.raster.h_sensor_mm, h_local, f.overlay.betaMm(), f.raster.covered_box, 5.0, followed);
+    benchmark::DoNotOptimize(stats.mean_pressure_mpa);
+  }
+}
 void BM_Stage_Shading(benchmark::State& state) {
   StageFixture f(state.range(0) != 0);
   norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()),
@@ -143,8 +166,10 @@ BENCHMARK(BM_Render_Textured_HeldCube)
     ->ArgsProduct({{0, 90}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
+BENCHMARK(BM_Render_Textured_HeldCube_Conformity)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Stage_Raster)->ArgNames({"cube", "uv"})->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Overlay)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_Conformity)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Gel)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Shading)
     ->ArgNames({"cube", "noise"})

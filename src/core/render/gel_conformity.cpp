@@ -1,0 +1,316 @@
+#include "norm2tex/render/gel_conformity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "norm2tex/common/error.hpp"
+
+namespace norm2tex {
+namespace {
+
+constexpr int kBands = GelConformity::kBandCount;
+constexpr double kPi = 3.14159265358979323846;
+// The bands' statistics are global over the contact: a thousand samples are plenty, so a
+// large contact is sampled on every 2nd to 8th row and column.
+constexpr long kEnoughSamples = 1000;
+// Bins of a band's values over the contact, for the mean rise of clipping it at a level.
+constexpr int kBins = 256;
+// Entries of the total mean rise as a function of the indentation (an 8-bit look-up).
+constexpr int kRiseEntries = 256;
+
+// Running sums of one band over the sampled contact.
+struct BandSums {
+  double min = std::numeric_limits<double>::infinity();
+  double max = -std::numeric_limits<double>::infinity();
+  double sum = 0.0, sum_sq = 0.0;  // of the values
+  double step_sq_x = 0.0, step_sq_y = 0.0;  // of the squared steps to the next pixel in x, y
+  std::array<double, kBins> counts{};
+};
+
+}  // namespace
+
+GelConformity::GelConformity(const ConformityOptions& options, double mm_per_pixel)
+    : options_(options), mm_per_pixel_(mm_per_pixel) {
+  if (!(options_.contact_modulus_mpa > 0.0 && options_.contact_modulus_mpa <= 100.0)) {
+    throw Error("conformity.contact_modulus_mpa = " + std::to_string(options_.contact_modulus_mpa) +
+                " is out of range; valid: (0, 100] MPa");
+  }
+  if (!(mm_per_pixel_ > 0.0 && std::isfinite(mm_per_pixel_))) {
+    throw Error("GelConformity: mm_per_pixel = " + std::to_string(mm_per_pixel_) +
+                " is out of range; valid: > 0");
+  }
+}
+
+ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local,
+                                     double beta_mm, cv::Rect box, double normal_force_n,
+                                     cv::Mat1f& followed_mm) {
+  if (!(std::isfinite(normal_force_n) && normal_force_n >= 0.0)) {
+    throw Error("normal force = " + std::to_string(normal_force_n) +
+                " N is not valid; valid: a finite force >= 0 N");
+  }
+  if (!(std::isfinite(beta_mm) && beta_mm >= 0.0)) {
+    throw Error("GelConformity: beta = " + std::to_string(beta_mm) + " mm; valid: >= 0 mm");
+  }
+  if (h_sensor_mm.size() != h_local.size()) {
+    throw Error("GelConformity: the indentation and the relief differ in size");
+  }
+  if (followed_mm.size() != h_local.size()) followed_mm = cv::Mat1f::zeros(h_local.size());
+  ConformityStats stats;
+  stats.normal_force_n = normal_force_n;
+  box &= cv::Rect(0, 0, h_local.cols, h_local.rows);
+  if (box.empty()) return stats;
+
+  // 1. The pressure: the force spread in proportion to the indentation (a Winkler foundation).
+  const cv::Mat1f h = h_sensor_mm(box);  // >= 0 (the rasterizer clamps it)
+  double indentation_sum = 0.0;
+  long contact_pixels = 0;
+  float deepest = 0.0f;
+  {
+    // One pass, in eight lanes the compiler vectorises (a plain float sum it may not reorder).
+    constexpr int kLanes = 8;
+    for (int r = 0; r < h.rows; ++r) {
+      const float* row = h.ptr<float>(r);
+      float sum[kLanes] = {}, top[kLanes] = {};
+      int count[kLanes] = {};
+      int c = 0;
+      for (; c + kLanes <= h.cols; c += kLanes) {
+        for (int j = 0; j < kLanes; ++j) {
+          const float depth = row[c + j];
+          sum[j] += depth;
+          count[j] += depth > 0.0f ? 1 : 0;
+          top[j] = std::max(top[j], depth);
+        }
+      }
+      for (; c < h.cols; ++c) {
+        sum[0] += row[c];
+        count[0] += row[c] > 0.0f ? 1 : 0;
+        top[0] = std::max(top[0], row[c]);
+      }
+      for (int j = 0; j < kLanes; ++j) {
+        indentation_sum += sum[j];
+        contact_pixels += count[j];
+        deepest = std::max(deepest, top[j]);
+      }
+    }
+  }
+  const double pixel_area = mm_per_pixel_ * mm_per_pixel_;
+  stats.contact_area_mm2 = contact_pixels * pixel_area;
+  stats.mean_pressure_mpa =  // N / mm^2 = MPa
+      contact_pixels > 0 ? normal_force_n / stats.contact_area_mm2 : 0.0;
+  const double pressure_per_mm =
+      indentation_sum > 0.0 ? normal_force_n / (indentation_sum * pixel_area) : 0.0;
+
+  // 2. The bands: differences of successive blurs of the relief, a Gaussian pyramid (each
+  //    level the 5-tap binomial and every second pixel), each level expanded back to full
+  //    resolution: cheap, and the bands telescope, summing to the relief exactly.
+  h_local(box).convertTo(smoothed_[0], CV_32F, beta_mm);  // the relief, mm
+  cv::pyrDown(smoothed_[0], half_[0], cv::Size((box.width + 1) / 2, (box.height + 1) / 2),
+              cv::BORDER_DEFAULT);
+  cv::pyrDown(half_[0], half_[1], cv::Size((half_[0].cols + 1) / 2, (half_[0].rows + 1) / 2),
+              cv::BORDER_DEFAULT);
+  // Back up by pyrUp, aligned with pyrDown's grid (a resize would shift each level by a
+  // fraction of its pixel, and the differences would hold that shift, not texture).
+  cv::pyrUp(half_[0], smoothed_[1], box.size(), cv::BORDER_DEFAULT);
+  cv::pyrUp(half_[1], up_, half_[0].size(), cv::BORDER_DEFAULT);
+  cv::pyrUp(up_, smoothed_[2], box.size(), cv::BORDER_DEFAULT);
+  // Band k runs from level fine[k] to level coarse[k] (kBands: nothing, the residual). Every
+  // smoothed_ is continuous and box-sized, so a pixel is one offset into each.
+  const float* level_data[kBands] = {smoothed_[0].ptr<float>(), smoothed_[1].ptr<float>(),
+                                     smoothed_[2].ptr<float>()};
+  std::array<int, kBands> fine{0, 1, 2}, coarse{1, 2, kBands};
+  std::array<bool, kBands> active{true, true, true};
+  const auto bandAt = [&](int k, int offset) -> float {
+    return coarse[k] < kBands ? level_data[fine[k]][offset] - level_data[coarse[k]][offset]
+                              : level_data[fine[k]][offset];
+  };
+
+  // 3. Where to sample the bands' statistics: contact pixels (all of the box when only crests
+  //    touch) on a grid, off the box's border so that each has its neighbours.
+  const bool anywhere = contact_pixels == 0;
+  const long region = anywhere ? long(box.area()) : contact_pixels;
+  const int stride =
+      std::max(1, std::min(8, static_cast<int>(std::sqrt(double(region) / kEnoughSamples))));
+  sample_offsets_.clear();
+  sample_depths_.clear();
+  for (int r = 1; r + 1 < box.height; r += stride) {
+    const float* hr = h.ptr<float>(r);
+    for (int c = 1; c + 1 < box.width; c += stride) {
+      if (!anywhere && !(hr[c] > 0.0f)) continue;
+      sample_offsets_.push_back(r * box.width + c);
+      sample_depths_.push_back(hr[c]);
+    }
+  }
+  const long samples = static_cast<long>(sample_offsets_.size());
+  const int* const offsets = sample_offsets_.data();
+  // A band with under 5 % of the relief's RMS is folded into the next coarser one: it holds
+  // no wavelength of its own, only the tail of a neighbour's (a pure sinusoid leaves a sliver
+  // in every band), and its statistics would be the interpolation's, not the texture's.
+  const auto rmsOver = [&](const auto& value) {
+    double sum = 0.0, sum_sq = 0.0;
+    for (long i = 0; i < samples; ++i) {
+      const double v = value(offsets[i]);
+      sum += v;
+      sum_sq += v * v;
+    }
+    const double mean = samples > 0 ? sum / samples : 0.0;
+    return samples > 0 ? std::sqrt(std::max(0.0, sum_sq / samples - mean * mean)) : 0.0;
+  };
+  const double relief_rms = rmsOver([&](int o) { return level_data[0][o]; });
+  for (int k = 0, start = 0; k < kBands; ++k) {
+    fine[k] = start;
+    if (k + 1 < kBands && rmsOver([&](int o) { return bandAt(k, o); }) < 0.05 * relief_rms) {
+      active[k] = false;  // its levels go to band k + 1
+      continue;
+    }
+    start = k + 1;
+  }
+  // Each band's extremes, RMS and RMS step to the next pixel, then its histogram.
+  std::array<BandSums, kBands> sums;
+  double relief_min = std::numeric_limits<double>::infinity(), relief_max = -relief_min;
+  {
+    const float* relief = smoothed_[0].ptr<float>();
+    for (long i = 0; i < samples; ++i) {
+      relief_min = std::min(relief_min, double(relief[offsets[i]]));
+      relief_max = std::max(relief_max, double(relief[offsets[i]]));
+    }
+  }
+  std::array<double, kBands> bin_width{};
+  for (int k = 0; k < kBands; ++k) {
+    if (!active[k]) continue;
+    const int w = box.width;
+    BandSums& s = sums[k];
+    for (long i = 0; i < samples; ++i) {
+      const int o = offsets[i];
+      const double v = bandAt(k, o);
+      s.min = std::min(s.min, v);
+      s.max = std::max(s.max, v);
+      s.sum += v;
+      s.sum_sq += v * v;
+      const double dx = bandAt(k, o + 1) - v, dy = bandAt(k, o + w) - v;
+      s.step_sq_x += dx * dx;
+      s.step_sq_y += dy * dy;
+    }
+    bin_width[k] = std::max(s.max - s.min, 1e-12) / kBins;
+    const double bins_per_mm = 1.0 / bin_width[k];
+    for (long i = 0; i < samples; ++i) {
+      const int bin = static_cast<int>((bandAt(k, offsets[i]) - s.min) * bins_per_mm);
+      s.counts[std::min(std::max(bin, 0), kBins - 1)] += 1.0;
+    }
+  }
+  stats.relief_amplitude_mm = samples > 0 ? 0.5 * (relief_max - relief_min) : 0.0;
+
+  // 4. Per band: Johnson's p*, and its patch-edge level at indentation h,
+  //    level = crest - 2 A p / p* with p = pressure_per_mm h: the band's lowest value at p*,
+  //    and lower still beyond (nothing clipped); -inf for a flat band.
+  std::array<float, kBands> crest{}, sink_per_mm{}, full_sink{};
+  for (int k = 0; k < kBands; ++k) {
+    const BandSums& s = sums[k];
+    ConformityBand& out = stats.bands[k];
+    crest[k] = -std::numeric_limits<float>::infinity();
+    if (samples == 0 || !active[k]) continue;
+    const double mean = s.sum / samples;
+    const double variance = std::max(0.0, s.sum_sq / samples - mean * mean);
+    out.amplitude_mm = 0.5 * (s.max - s.min);
+    if (!(out.amplitude_mm > 0.0) || !(variance > 0.0)) continue;
+    // The dominant wavenumber from the RMS step to the next pixel: a sinusoid of wavenumber w
+    // (per pixel) steps by 2 sin(w / 2) times its RMS, inverted exactly per axis (a central
+    // difference's sin(w) / w would make the finest band's wavelength up to 1.7x too long).
+    const auto wavenumberAlong = [&](double step_sq) {
+      const double ratio = std::sqrt(step_sq / samples / variance);
+      return 2.0 * std::asin(std::min(1.0, 0.5 * ratio));
+    };
+    const double wx = wavenumberAlong(s.step_sq_x), wy = wavenumberAlong(s.step_sq_y);
+    const double wavenumber_per_mm = std::sqrt(wx * wx + wy * wy) / mm_per_pixel_;
+    if (!(wavenumber_per_mm > 0.0)) continue;
+    out.wavelength_mm = 2.0 * kPi / wavenumber_per_mm;
+    out.full_contact_pressure_mpa =
+        kPi * options_.contact_modulus_mpa * stats.relief_amplitude_mm / out.wavelength_mm;
+    crest[k] = static_cast<float>(s.max);
+    full_sink[k] = static_cast<float>(4.0 * out.amplitude_mm);  // see step 6
+    sink_per_mm[k] = static_cast<float>(2.0 * out.amplitude_mm * pressure_per_mm /
+                                        out.full_contact_pressure_mpa);
+    // The depth it follows, min(1, p / p*), averaged over the (sampled) contact.
+    if (!anywhere) {
+      const double ratio_per_mm = pressure_per_mm / out.full_contact_pressure_mpa;
+      double followed = 0.0;
+      for (long i = 0; i < samples; ++i) {
+        followed += std::min(1.0, ratio_per_mm * sample_depths_[i]);
+      }
+      out.followed_fraction = followed / samples;
+    }
+  }
+  const auto levelAt = [&](int k, float depth) {
+    return crest[k] - std::min(sink_per_mm[k] * depth, full_sink[k]);
+  };
+
+  // 5. Clipping a band at level L raises its mean by rise(L) = mean over the contact of
+  //    (L - band)+. The gel's mean indentation is the physics' (the law gives the force for
+  //    H_sensor), so each pixel's rise is taken off again: the texture only redistributes the
+  //    indentation, and where p = 0 a band sits at its mean. rise(L) from the band's histogram
+  //    (right for any distribution of heights, not only a sinusoid's); the levels depend on
+  //    the indentation only, so the rise of all bands is tabulated against it.
+  // Prefix sums over the bins: count and sum of the bin centres below each bin edge.
+  std::array<std::array<double, kBins + 1>, kBands> below_count{}, below_sum{};
+  for (int k = 0; k < kBands; ++k) {
+    for (int j = 0; j < kBins; ++j) {
+      const double centre = sums[k].min + (j + 0.5) * bin_width[k];
+      below_count[k][j + 1] = below_count[k][j] + sums[k].counts[j];
+      below_sum[k][j + 1] = below_sum[k][j] + sums[k].counts[j] * centre;
+    }
+  }
+  const auto riseAt = [&](int k, float level) {
+    if (!(level > sums[k].min)) return 0.0;
+    const double edge = std::floor((level - sums[k].min) / bin_width[k] + 0.5);
+    const int j = static_cast<int>(std::min(edge, double(kBins)));  // bins with centre < level
+    return (level * below_count[k][j] - below_sum[k][j]) / samples;
+  };
+  rise_table_.create(1, kRiseEntries);
+  const double depth_step = std::max(double(deepest), 1e-9) / (kRiseEntries - 1);
+  for (int i = 0; i < kRiseEntries; ++i) {
+    double rise = 0.0;
+    for (int k = 0; k < kBands; ++k) {
+      if (crest[k] > -std::numeric_limits<float>::infinity()) {
+        rise += riseAt(k, levelAt(k, static_cast<float>(i * depth_step)));
+      }
+    }
+    rise_table_(0, i) = static_cast<float>(rise);
+  }
+
+  // 6. The followed relief: every band clipped at its edge level, the mean rise taken off.
+  //    Band by band over each row, branch-free, so the compiler vectorises it.
+  for (int r = 0; r < box.height; ++r) {
+    const float* __restrict hr = h.ptr<float>(r);
+    float* __restrict out = followed_mm.ptr<float>(box.y + r) + box.x;
+    std::fill(out, out + box.width, 0.0f);
+    for (int k = 0; k < kBands; ++k) {
+      if (!active[k]) continue;
+      const float* __restrict upper = smoothed_[fine[k]].ptr<float>(r);
+      const float top = crest[k], per_mm = sink_per_mm[k], full = full_sink[k];
+      // Past p* the level keeps sinking below the band's lowest sample (to a whole range below
+      // it): nothing is clipped. min / max only, so the compiler vectorises the loops.
+      if (coarse[k] == kBands) {
+        for (int c = 0; c < box.width; ++c) {
+          const float level = top - std::min(per_mm * hr[c], full);
+          out[c] += std::max(upper[c], level);
+        }
+        continue;
+      }
+      const float* __restrict lower = smoothed_[coarse[k]].ptr<float>(r);
+      for (int c = 0; c < box.width; ++c) {
+        const float level = top - std::min(per_mm * hr[c], full);
+        out[c] += std::max(upper[c] - lower[c], level);
+      }
+    }
+  }
+  // The rise by indentation, quantised to 256 levels (cv::LUT, vectorised).
+  h.convertTo(depth_levels_, CV_8U, (kRiseEntries - 1) / std::max(double(deepest), 1e-9));
+  cv::LUT(depth_levels_, rise_table_, rise_);
+  cv::subtract(followed_mm(box), rise_, followed_mm(box));
+  return stats;
+}
+
+}  // namespace norm2tex
