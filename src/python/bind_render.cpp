@@ -86,6 +86,15 @@ void bindRender(py::module& m) {
       .def_readwrite("gel_thickness_mm", &SensorModel::gel_thickness_mm, "indentation limit, mm")
       .def_readwrite("gel_pad_width_mm", &SensorModel::gel_pad_width_mm, "physical pad, mm")
       .def_readwrite("gel_pad_height_mm", &SensorModel::gel_pad_height_mm, "physical pad, mm")
+      .def_property(
+          "conformity_enabled", [](const SensorModel& s) { return s.conformity.enabled; },
+          [](SensorModel& s, bool on) { s.conformity.enabled = on; },
+          "pressure-dependent conformity of the gel to the texture (off: the fixed-depth overlay)")
+      .def_property(
+          "contact_modulus_mpa",
+          [](const SensorModel& s) { return s.conformity.contact_modulus_mpa; },
+          [](SensorModel& s, double e) { s.conformity.contact_modulus_mpa = e; },
+          "the gel's contact modulus E*, MPa (the conformity model's)")
       .def_readwrite("background_image", &SensorModel::background_image,
                      "no-contact frame (bgr image file); empty: the synthetic background")
       .def_property_readonly(
@@ -330,19 +339,24 @@ void bindRender(py::module& m) {
           "without UVs.")
       .def(
           "render",
-          [](TactileRenderer& r, const py::object& object_in_gel, std::int64_t noise_seed) {
+          [](TactileRenderer& r, const py::object& object_in_gel, std::int64_t noise_seed,
+             std::optional<double> normal_force_n) {
             const Eigen::Isometry3d pose = poseFromPython(object_in_gel, "object_in_gel");
             const TactileFrame* frame;
             {
               py::gil_scoped_release release;
-              frame = &r.render(pose, noise_seed);
+              frame = &r.render(pose, noise_seed, normal_force_n);
             }
             return copyFrame(*frame);
           },
           py::arg("object_in_gel"), py::arg("noise_seed") = -1,
+          py::arg("normal_force_n") = py::none(),
           "Renders the object at `object_in_gel` (the object frame in the gel frame, metres: a "
           "4x4 matrix or (xyz, quaternion xyzw)); noise drawn from noise_seed (< 0: none). "
-          "Returns a RenderedFrame. Raises norm2tex.Error for a non-finite pose or no object.")
+          "normal_force_n (N): the contact's force, which sets how much of the texture the gel "
+          "follows when the sensor's conformity is on (None: the gel law's force for the press). "
+          "Returns a RenderedFrame. Raises norm2tex.Error for a non-finite pose or force, or no "
+          "object.")
       .def_property_readonly("background",
                              [](const TactileRenderer& r) { return toNumpy(r.shader().background()); },
                              "the no-contact frame without noise, (rows, cols, 3) uint8")

@@ -211,3 +211,28 @@ def test_calibration_equals_the_cli_on_real_presses(sensor, tmp_path):
                                   [norm2tex.read_image(presses[0])], ball_diameter_mm=6.0)
     with pytest.raises(norm2tex.Error, match="nothing.jpg"):
         norm2tex.read_image(os.path.join(fixtures, "nothing.jpg"))
+
+
+def test_conformity_from_python_follows_the_force(sensor, cube):
+    """With the sensor's conformity on, a harder press of the same pose shows more texture;
+    off, the force changes nothing."""
+    atlas, mesh, beta_mm, _ = norm2tex.material_texture(norm2tex.material_config("wood"), cube)
+    pose = pose_matrix(0.0, 0.0, 0.015 - 0.0008, 0.0, 0.0, 0.0)
+    on = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    on.conformity_enabled = True
+    textureless = norm2tex.TactileRenderer(on)
+    textureless.set_object(mesh)
+    flat = textureless.render(pose).image.astype(np.int16)
+    rms = []
+    for force in (1.0, 20.0):
+        renderer = norm2tex.TactileRenderer(on)
+        renderer.set_object(mesh, atlas, beta_mm)
+        image = renderer.render(pose, normal_force_n=force).image.astype(np.int16)
+        rms.append(float(np.sqrt(np.mean((image - flat) ** 2))))
+    assert rms[0] < rms[1]
+    off = norm2tex.TactileRenderer(sensor)
+    off.set_object(mesh, atlas, beta_mm)
+    np.testing.assert_array_equal(off.render(pose, normal_force_n=1.0).image,
+                                  off.render(pose, normal_force_n=20.0).image)
+    with pytest.raises(norm2tex.Error, match="force"):
+        off.render(pose, normal_force_n=-1.0)
