@@ -509,10 +509,27 @@ void ContactSim::advanceFrame() {
   publishFrame();
 }
 
+void ContactSim::waitForTfSubscribers() {
+  // A renderer answers "ready" once it is subscribed, but its TF listener's connection to this
+  // /tf publisher is made asynchronously: a first frame's TF sent before it is up was lost, and
+  // that frame had no images ("source_frame object does not exist"). TF is not latched, so wait
+  // (once, within ~ready_timeout) until every renderer's listener is connected.
+  if (tf_connected_) return;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.ready_timeout);
+  while (tf_pub_.getNumSubscribers() < params_.renderers.size() && ros::ok() &&
+         ros::WallTime::now() < deadline) {
+    ros::WallDuration(0.005).sleep();
+  }
+  tf_connected_ = true;  // late ones show as frames without images, with the reason
+}
+
 std::uint32_t ContactSim::publishFrame() {
   const ros::Time stamp = frameStamp();
   const bool acknowledge = lock_step_->waits();
-  if (acknowledge) lock_step_->waitUntilReady();
+  if (acknowledge) {
+    lock_step_->waitUntilReady();
+    waitForTfSubscribers();
+  }
   if (owns_clock_) {
     rosgraph_msgs::Clock clock;
     clock.clock = stamp;
@@ -571,6 +588,10 @@ std::uint32_t ContactSim::publishFrame() {
   frame.variant = static_cast<std::uint32_t>(params_.variant);
   frame.next_material = next_material_;
   frame.next_variant = next_variant_;
+  for (int i = 0; i < 2; ++i) {
+    frame.sensors.push_back(kSensorNames[i]);
+    frame.normal_force.push_back(sim_->contact(static_cast<Finger>(i)).normal_force_n);
+  }
   // Lock-step: every renderer answers this frame before the next one is simulated.
   return lock_step_->publish(frame_pub_, frame);
 }

@@ -97,6 +97,8 @@ class ContactSim {
   bool tooDeep() const;
   /// Advances one sensor frame of physics and publishes it.
   void advanceFrame();
+  /// Before the first acknowledged frame: until every renderer listens on /tf (bounded).
+  void waitForTfSubscribers();
   /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.
   /// Returns how many of them published no image; throws Error when one did not answer in time.
   std::uint32_t publishFrame();
@@ -110,6 +112,7 @@ class ContactSim {
   std::int64_t frame_ = 0;  ///< sensor frames since start (the simulated clock)
   ros::Time time_base_;     ///< added to simulated time: 0 with use_sim_time, else wall
   bool owns_clock_ = false;
+  bool tf_connected_ = false;  ///< every renderer's TF listener was seen connected to /tf
   /// Real time with wall stamps: re-anchor simulated time on the wall clock at the next frame.
   bool anchor_to_wall_ = false;
   ros::WallTime wall_anchor_;  ///< real time: when frame anchor_frame_ + 1 was due

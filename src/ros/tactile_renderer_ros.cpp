@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include <ros/package.h>
@@ -273,7 +274,13 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
                                         ? -1
                                         : static_cast<std::int64_t>(params_.noise_seed) * 1000003 +
                                               static_cast<std::int64_t>(frame->frame);
-    const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed);
+    // The gel's normal force when the source knows it (contact_sim), for the texture's
+    // conformity; else the renderer takes the gel law's force for the press.
+    std::optional<double> normal_force_n;
+    for (std::size_t i = 0; i < frame->sensors.size() && i < frame->normal_force.size(); ++i) {
+      if (frame->sensors[i] == params_.sensor_name) normal_force_n = frame->normal_force[i];
+    }
+    const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed, normal_force_n);
     std_msgs::Header header;
     header.stamp = frame->header.stamp;
     header.frame_id = params_.gel_frame;

@@ -1,6 +1,7 @@
 """RosBackend against InProcessBackend: the same seeds, offsets, commands and texture variants
 give the same gripper states and images over a running gripper_sim.launch (synchronous, noise
-off, texture_from_frame) as in-process; and RosBackend's refusals carry contact_sim's reasons.
+off, texture_from_frame, the texture's conformity on: the gels' forces reach the renderers) as
+in-process; and RosBackend's refusals carry contact_sim's reasons.
 
 Starts its own master on a free port (scripts/free_port). Run (with the workspace sourced):
     /usr/bin/python3 -m pytest -q test/python/test_ros_backend.py
@@ -32,7 +33,20 @@ def _free_port():
 
 
 @pytest.fixture(scope="module")
-def ros_system():
+def sensor_yaml():
+    """The default DIGIT with the texture's conformity on: both sides must then pass the gels'
+    normal forces to their renderers (contact_sim in SimFrame.normal_force) to agree."""
+    import norm2tex
+
+    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    model.conformity_enabled = True
+    path = os.path.join(tempfile.mkdtemp(prefix="norm2tex_ros_backend_sensor_"), "digit.yaml")
+    model.save(path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def ros_system(sensor_yaml):
     """gripper_sim.launch mode:=synchronous on a master of its own; this process's rospy on it."""
     home = tempfile.mkdtemp(prefix="norm2tex_ros_backend_test_")
     port = _free_port()
@@ -42,7 +56,8 @@ def ros_system():
     log = open(os.path.join(home, "roslaunch.log"), "w+")
     launch = subprocess.Popen(
         ["roslaunch", "-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=synchronous",
-         "noise_seed:=-1", "texture_from_frame:=true", "seed:=%d" % LAUNCH_SEED],
+         "noise_seed:=-1", "texture_from_frame:=true", "seed:=%d" % LAUNCH_SEED,
+         "sensor:=" + sensor_yaml],
         env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
     os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
     try:
@@ -59,7 +74,7 @@ def ros_system():
 
 
 @pytest.fixture(scope="module")
-def backends(ros_system):
+def backends(ros_system, sensor_yaml):
     from norm2tex.envs.inprocess_backend import InProcessBackend
     from norm2tex.envs.ros_backend import RosBackend
 
@@ -70,7 +85,8 @@ def backends(ros_system):
         log.seek(0)
         print(log.read()[-4000:])
         raise
-    inproc = InProcessBackend(seed=LAUNCH_SEED, noise_seed=None, noise_per_episode=False)
+    inproc = InProcessBackend(seed=LAUNCH_SEED, noise_seed=None, noise_per_episode=False,
+                              sensor=sensor_yaml)
     yield ros, inproc
     ros.close()
     inproc.close()
@@ -200,12 +216,13 @@ def test_no_system_is_a_clear_error(ros_system):
         RosBackend(namespace="/nowhere", service_timeout_s=0.5)
 
 
-def test_the_environment_is_the_same_over_both_backends(backends):
+def test_the_environment_is_the_same_over_both_backends(backends, sensor_yaml):
     """GripperEnv over ROS and in-process: same seeds and actions, the same observations."""
     from norm2tex.envs import GripperEnv
 
-    over_ros = GripperEnv(backend="ros", noise=False, ros_options={"service_timeout_s": 40.0})
-    in_process = GripperEnv(noise=False)
+    over_ros = GripperEnv(backend="ros", noise=False, sensor=sensor_yaml,
+                          ros_options={"service_timeout_s": 40.0})
+    in_process = GripperEnv(noise=False, sensor=sensor_yaml)
     assert over_ros.observation_space.keys() == in_process.observation_space.keys()
     actions = np.random.default_rng(1).integers(0, 3, size=25)
     for seed in (1, 2):
