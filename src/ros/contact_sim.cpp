@@ -2,6 +2,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -513,9 +514,11 @@ void ContactSim::waitForTfSubscribers() {
   // A renderer answers "ready" once it is subscribed, but its TF listener's connection to this
   // /tf publisher is made asynchronously: a first frame's TF sent before it is up was lost, and
   // that frame had no images ("source_frame object does not exist"). TF is not latched, so wait
-  // (once, within ~ready_timeout) until every renderer's listener is connected.
+  // (once) until as many /tf subscribers as ~renderers are connected: a connection takes
+  // milliseconds; a listed node that reads no TF delays the first frame by at most 5 s.
   if (tf_connected_) return;
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(params_.ready_timeout);
+  const double wait_s = std::min(params_.ready_timeout, 5.0);
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait_s);
   while (tf_pub_.getNumSubscribers() < params_.renderers.size() && ros::ok() &&
          ros::WallTime::now() < deadline) {
     ros::WallDuration(0.005).sleep();
