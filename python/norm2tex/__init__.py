@@ -43,6 +43,7 @@ _CORE_NAMES = (
     "EpisodeOptions",
     "SceneConfig",
     "GripperSim",
+    "GelLaw",
     "TactileGripperOptions",
     "TactileGripperBatch",
 )

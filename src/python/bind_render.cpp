@@ -87,6 +87,10 @@ void bindRender(py::module& m) {
       .def_readwrite("gel_pad_width_mm", &SensorModel::gel_pad_width_mm, "physical pad, mm")
       .def_readwrite("gel_pad_height_mm", &SensorModel::gel_pad_height_mm, "physical pad, mm")
       .def_property(
+          "gel_final_sigma_mm", [](const SensorModel& s) { return s.gel.final_sigma_mm; },
+          [](SensorModel& s, double sigma) { s.gel.final_sigma_mm = sigma; },
+          "the gel model's last blur, mm (gel_model.final_sigma_mm)")
+      .def_property(
           "conformity_enabled", [](const SensorModel& s) { return s.conformity.enabled; },
           [](SensorModel& s, bool on) { s.conformity.enabled = on; },
           "pressure-dependent conformity of the gel to the texture (off: the fixed-depth overlay)")

@@ -10,6 +10,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "norm2tex/sim/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/sim/tactile_gripper.hpp"
 #include "norm2tex/sim/tactile_gripper_batch.hpp"
@@ -69,6 +70,16 @@ py::array stackImages(const TactileGripperBatch& batch, Finger finger) {
 }  // namespace
 
 void bindSim(py::module& m) {
+  py::class_<GelLaw>(m, "GelLaw",
+                     "The gel's force-indentation law (scene yaml gel.law): normal force of a "
+                     "contact from its deepest indentation, piecewise power law through points.")
+      .def(py::init<std::vector<std::pair<double, double>>>(), py::arg("points"),
+           "(indentation m, force N) pairs, strictly increasing in both.")
+      .def_static("default", &GelLaw::taximDefault, "the scenes' default law")
+      .def("force", &GelLaw::force, py::arg("indentation_m"), "N at an indentation (m)")
+      .def("indentation", &GelLaw::indentation, py::arg("force_n"),
+           "m at a force (N): the inverse of force()")
+      .def_property_readonly("points", &GelLaw::points);
   py::class_<GripperOptions>(m, "GripperOptions", "scene yaml section gripper")
       .def_readwrite("base_height_m", &GripperOptions::base_height_m)
       .def_readwrite("min_gap_m", &GripperOptions::min_gap_m, "gel gap at opening 0, m")

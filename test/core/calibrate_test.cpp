@@ -201,9 +201,11 @@ TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
 }
 
 // Without the scale, the real presses do not pin it (ScaleSearch: a response fitted per unit
-// absorbs most of a change of scale, and real presses fit best at the smallest scale searched,
-// as presses rendered with the analytic LEDs do). The calibration must say so: the fit is
-// flagged at the bound, and its profile shows the source's own scale fitting nearly as well.
+// absorbs most of a change of scale, and real presses fit best near the smallest scale
+// searched, as presses rendered with the analytic LEDs do). The calibration must say so: the fit
+// is flagged at the bound or the scales that fit within kScaleIndifference span more than 10 %
+// (what the tool warns about), and the profile shows the source's own scale fitting nearly as
+// well.
 TEST(Calibration, RealPressesWithoutTheScaleAreFlaggedAsNotPinningIt) {
   CalibrationInput input;
   input.backgrounds.push_back(fixtureFrame(30));
@@ -211,8 +213,10 @@ TEST(Calibration, RealPressesWithoutTheScaleAreFlaggedAsNotPinningIt) {
   input.ball_diameter_mm = 6.0;
   const CalibrationResult result = calibrateSensor(makeDigitSensorModel(), input);
   for (const std::string& line : describeScaleSearch(result.fit)) std::printf("%s\n", line.c_str());
-  EXPECT_TRUE(result.fit.scale_at_search_bound) << result.model.mm_per_pixel;
   const ScaleSearch& search = result.fit.scale_search;
+  EXPECT_TRUE(result.fit.scale_at_search_bound || search.range_max > 1.1 * search.range_min)
+      << result.model.mm_per_pixel << " mm/px; fits as well over " << search.range_min << "-"
+      << search.range_max;
   ASSERT_GE(search.profile.size(), 6u);
   EXPECT_NEAR(search.range_min, kMinSearchedScale, 1e-9);
   double best = 0.0, at_source_scale = 0.0, nearest = 1e9;

@@ -312,8 +312,9 @@ TEST(ConformityRender, BallShowsMoreTextureAtItsCentreThanNearItsRim) {
 
 TEST(ConformityRender, OffIsTheFixedDepthOverlayBitForBit) {
   // Conformity off: the renderer is exactly today's stages in a row, whatever force it gets.
-  const SensorModel model = makeDigitSensorModel();
-  ASSERT_FALSE(model.conformity.enabled) << "the shipped default is off in this increment";
+  SensorModel model = makeDigitSensorModel();
+  ASSERT_TRUE(model.conformity.enabled) << "the default is on";
+  model.conformity.enabled = false;
   const auto ball = std::make_shared<const TexturedMesh>(makeUvSphere(5e-3, 96, 192));
   const auto atlas = randomAtlas(2.0);
   const double beta = 0.2;
@@ -338,6 +339,45 @@ TEST(ConformityRender, OffIsTheFixedDepthOverlayBitForBit) {
       EXPECT_FALSE(frame.conformity.has_value());
       EXPECT_EQ(cv::norm(frame.image, expected, cv::NORM_INF), 0.0) << "press " << press_mm;
       EXPECT_EQ(cv::norm(frame.gel_mm, gel_mm, cv::NORM_INF), 0.0) << "press " << press_mm;
+    }
+  }
+}
+
+TEST(ConformityRender, OnIsTheStagesInARowWithTheFollowedRelief) {
+  // The renderer's one-pass path (GelConformity::applyToFinal) gives what the overlay, then
+  // apply()'s followed relief in place of beta H_local, then the gel and the shading give.
+  const SensorModel model = makeDigitSensorModel();
+  const auto ball = std::make_shared<const TexturedMesh>(makeUvSphere(5e-3, 96, 192));
+  const auto atlas = randomAtlas(2.0);
+  const double beta = 0.2;
+  TactileRenderer renderer(model);
+  renderer.setObject(ball, atlas, beta);
+  const ContactRasterizer rasterizer(model);
+  const TextureOverlay overlay(atlas, beta);
+  GelConformity conformity(model.conformity, model.mm_per_pixel);
+  const GelModel gel(model);
+  const DigitShader shader(model, makeSyntheticBackground(model.imageSize()),
+                           BackgroundSource::kSynthetic);
+  for (double press_mm : {0.3, 1.0}) {
+    const auto pose = poseMm(0.7, -1.1, 5.0 - press_mm);
+    for (double force : {0.5, 4.0, 30.0}) {
+      ContactRaster raster;
+      rasterizer.rasterize(*ball, pose, overlay.reachMm(), true, raster);
+      cv::Mat1f h_final, h_local, followed, gel_mm;
+      overlay.apply(raster, model.gel_thickness_mm, h_final, &h_local);
+      conformity.apply(raster.h_sensor_mm, h_local, beta, raster.covered_box, force, followed);
+      const cv::Rect box = raster.covered_box;
+      cv::Mat1f rewritten = followed(box) - raster.gap_mm(box);
+      rewritten = cv::max(cv::min(rewritten, model.gel_thickness_mm), 0.0);
+      rewritten.copyTo(h_final(box));
+      gel.apply(h_final, gel_mm);
+      const cv::Mat3b expected = shader.shade(gel_mm, 7);
+      const TactileFrame& frame = renderer.render(pose, 7, force);
+      ASSERT_TRUE(frame.conformity.has_value());
+      EXPECT_EQ(cv::norm(frame.gel_mm, gel_mm, cv::NORM_INF), 0.0)
+          << "press " << press_mm << " mm, " << force << " N";
+      EXPECT_EQ(cv::norm(frame.image, expected, cv::NORM_INF), 0.0)
+          << "press " << press_mm << " mm, " << force << " N";
     }
   }
 }

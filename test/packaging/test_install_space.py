@@ -30,7 +30,8 @@ PROGRAMS = [
     "norm2tex_bake", "norm2tex_texgen", "norm2tex_render", "norm2tex_calibrate", "norm2tex_export",
     "norm2tex_grasp_demo", "norm2tex_gripper_sweep", "norm2tex_make_demo_normal_map",
     "norm2tex_ros_bench", "norm2tex_wake_bench", "norm2tex_launch_check",
-    "record_dataset", "free_port", "merge_dataset", "train_material_classifier", "ros_benchmark", "env_benchmark",
+    "record_dataset", "free_port", "merge_dataset", "train_material_classifier", "texture_contrast",
+    "ros_benchmark", "env_benchmark",
     "slurm/submit_dataset", "slurm/record_dataset.sbatch",
 ]
 

@@ -230,7 +230,10 @@ def test_conformity_from_python_follows_the_force(sensor, cube):
         image = renderer.render(pose, normal_force_n=force).image.astype(np.int16)
         rms.append(float(np.sqrt(np.mean((image - flat) ** 2))))
     assert rms[0] < rms[1]
-    off = norm2tex.TactileRenderer(sensor)
+    assert sensor.conformity_enabled, "on by default"
+    off_model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    off_model.conformity_enabled = False
+    off = norm2tex.TactileRenderer(off_model)
     off.set_object(mesh, atlas, beta_mm)
     np.testing.assert_array_equal(off.render(pose, normal_force_n=1.0).image,
                                   off.render(pose, normal_force_n=20.0).image)

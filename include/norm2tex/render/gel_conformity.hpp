@@ -69,6 +69,16 @@ class GelConformity {
   ConformityStats apply(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local, double beta_mm,
                         cv::Rect box, double normal_force_n, cv::Mat1f& followed_mm);
 
+  /// As apply(), but writes H_final = clamp(followed - gap_mm, 0, thickness_mm) over `box`
+  /// straight into `h_final_mm` (which must be of the image size), in the same pass: the
+  /// renderer's path. `gap_mm`: the smooth surface's height above the gel (the rasterizer's,
+  /// negative where it presses in), so followed - gap is the texture overlay's H_final with the
+  /// followed relief in place of beta H_local.
+  ConformityStats applyToFinal(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local,
+                               double beta_mm, cv::Rect box, double normal_force_n,
+                               const cv::Mat1f& gap_mm, double thickness_mm,
+                               cv::Mat1f& h_final_mm);
+
   const ConformityOptions& options() const { return options_; }
   /// Bands: a Gaussian pyramid's levels (2 and 4 pixels) split the relief into three.
   static constexpr int kBandCount = 3;
@@ -82,8 +92,12 @@ class GelConformity {
   std::vector<int> sample_offsets_;     // where the statistics are sampled (scratch)
   std::vector<float> sample_depths_;    // H_sensor there
   cv::Mat1f rise_table_;               // the clipping's mean rise by quantised indentation
-  cv::Mat1b depth_levels_;             // the indentation quantised for it (scratch)
-  cv::Mat1f rise_;                     // the rise per pixel (scratch)
+  std::vector<float> row_;             // one row of the followed relief (applyToFinal's scratch)
+
+  // apply() and applyToFinal(): with `gap_mm`, H_final goes to `out`, else the followed relief.
+  ConformityStats run(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local, double beta_mm,
+                      cv::Rect box, double normal_force_n, const cv::Mat1f* gap_mm,
+                      float thickness_mm, cv::Mat1f& out);
 };
 
 }  // namespace norm2tex

@@ -57,14 +57,18 @@ struct GelOptions {
   /// contact radii at the rim; Taxim's 1.0 mm level gives 0.42-0.45 at the measured scale.
   std::vector<double> pyramid_sigmas_mm = {0.5, 0.25, 0.1};
   double core_fraction = 0.4;   ///< pixels indented more than this x max indentation: the core
-  double final_sigma_mm = 0.1;  ///< last blur over everything
+  /// Last blur over everything: the reflective coating's and the camera's smoothing (about one
+  /// QVGA pixel), not the gel's conformity to texture, which GelConformity models.
+  double final_sigma_mm = 0.05;
 };
 
 /// Pressure-dependent conformity of the gel to the texture (GelConformity, docs/sensor.md).
 /// Off: the paper's fixed-depth overlay, H_final = H_sensor + beta H_local wherever the object
 /// touches, whatever the force.
 struct ConformityOptions {
-  bool enabled = false;
+  /// On: the texture's depth follows the contact pressure (GelConformity); off: the paper's
+  /// fixed-depth overlay H_sensor + beta H_local.
+  bool enabled = true;
   /// The gel's contact modulus E* = E / (1 - nu^2), MPa: the default gel law (Taxim-robot's
   /// GelSight table) read as a flat face pressing the gel pad, E = F h / (A d), gives
   /// 0.05-0.16 MPa over 0.1-2 mm of indentation (0.08-0.10 over the measured 0.4-0.58 mm).

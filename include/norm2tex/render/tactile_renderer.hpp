@@ -77,7 +77,6 @@ class TactileRenderer {
   std::optional<TextureOverlay> overlay_;
   std::optional<GelConformity> conformity_;  // set when model.conformity.enabled
   GelLaw gel_law_ = GelLaw::taximDefault();
-  cv::Mat1f followed_;  // the relief the gel follows (GelConformity), over the covered box
   TactileFrame frame_;
   cv::Mat1f h_final_;
   cv::Rect overlay_box_;  // what the overlay wrote last frame

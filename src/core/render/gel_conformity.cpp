@@ -48,6 +48,25 @@ GelConformity::GelConformity(const ConformityOptions& options, double mm_per_pix
 ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local,
                                      double beta_mm, cv::Rect box, double normal_force_n,
                                      cv::Mat1f& followed_mm) {
+  return run(h_sensor_mm, h_local, beta_mm, box, normal_force_n, nullptr, 0.0f, followed_mm);
+}
+
+ConformityStats GelConformity::applyToFinal(const cv::Mat1f& h_sensor_mm,
+                                            const cv::Mat1f& h_local, double beta_mm,
+                                            cv::Rect box, double normal_force_n,
+                                            const cv::Mat1f& gap_mm, double thickness_mm,
+                                            cv::Mat1f& h_final_mm) {
+  if (gap_mm.size() != h_local.size() || h_final_mm.size() != h_local.size()) {
+    throw Error("GelConformity: the gap, H_final and the relief differ in size");
+  }
+  return run(h_sensor_mm, h_local, beta_mm, box, normal_force_n, &gap_mm,
+             static_cast<float>(thickness_mm), h_final_mm);
+}
+
+ConformityStats GelConformity::run(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local,
+                                   double beta_mm, cv::Rect box, double normal_force_n,
+                                   const cv::Mat1f* gap_mm, float thickness_mm,
+                                   cv::Mat1f& out_mm) {
   if (!(std::isfinite(normal_force_n) && normal_force_n >= 0.0)) {
     throw Error("normal force = " + std::to_string(normal_force_n) +
                 " N is not valid; valid: a finite force >= 0 N");
@@ -58,7 +77,7 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
   if (h_sensor_mm.size() != h_local.size()) {
     throw Error("GelConformity: the indentation and the relief differ in size");
   }
-  if (followed_mm.size() != h_local.size()) followed_mm = cv::Mat1f::zeros(h_local.size());
+  if (out_mm.size() != h_local.size()) out_mm = cv::Mat1f::zeros(h_local.size());
   ConformityStats stats;
   stats.normal_force_n = normal_force_n;
   box &= cv::Rect(0, 0, h_local.cols, h_local.rows);
@@ -280,11 +299,17 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
     rise_table_(0, i) = static_cast<float>(rise);
   }
 
-  // 6. The followed relief: every band clipped at its edge level, the mean rise taken off.
-  //    Band by band over each row, branch-free, so the compiler vectorises it.
+  // 6. The followed relief: every band clipped at its edge level, the mean rise taken off
+  //    (looked up by the indentation quantised to the table's entries), then, on the renderer's
+  //    path, H_final from it. Band by band over each row, branch-free, so the compiler
+  //    vectorises all but the table look-up.
+  const float levels_per_mm =
+      static_cast<float>((kRiseEntries - 1) / std::max(double(deepest), 1e-9));
+  const float* __restrict rise = rise_table_.ptr<float>();
+  row_.resize(box.width);
   for (int r = 0; r < box.height; ++r) {
     const float* __restrict hr = h.ptr<float>(r);
-    float* __restrict out = followed_mm.ptr<float>(box.y + r) + box.x;
+    float* __restrict out = gap_mm ? row_.data() : out_mm.ptr<float>(box.y + r) + box.x;
     std::fill(out, out + box.width, 0.0f);
     for (int k = 0; k < kBands; ++k) {
       if (!active[k]) continue;
@@ -305,11 +330,18 @@ ConformityStats GelConformity::apply(const cv::Mat1f& h_sensor_mm, const cv::Mat
         out[c] += std::max(upper[c] - lower[c], level);
       }
     }
+    for (int c = 0; c < box.width; ++c) {
+      const int level = static_cast<int>(hr[c] * levels_per_mm + 0.5f);  // hr <= deepest
+      out[c] -= rise[std::min(level, kRiseEntries - 1)];
+    }
+    if (gap_mm) {
+      const float* __restrict gap = gap_mm->ptr<float>(box.y + r) + box.x;
+      float* __restrict h_final = out_mm.ptr<float>(box.y + r) + box.x;
+      for (int c = 0; c < box.width; ++c) {
+        h_final[c] = std::min(std::max(out[c] - gap[c], 0.0f), thickness_mm);
+      }
+    }
   }
-  // The rise by indentation, quantised to 256 levels (cv::LUT, vectorised).
-  h.convertTo(depth_levels_, CV_8U, (kRiseEntries - 1) / std::max(double(deepest), 1e-9));
-  cv::LUT(depth_levels_, rise_table_, rise_);
-  cv::subtract(followed_mm(box), rise_, followed_mm(box));
   return stats;
 }
 

@@ -103,19 +103,9 @@ ConformityStats TactileRenderer::applyConformity(std::optional<double> normal_fo
     cv::minMaxLoc(h_sensor(box), nullptr, &deepest_mm);
     force_n = gel_law_.force(deepest_mm * 1e-3);
   }
-  const ConformityStats stats =
-      conformity_->apply(h_sensor, frame_.h_local, overlay_->betaMm(), box, force_n, followed_);
   // H_final again, as the overlay computes it, from the followed relief instead of the full one.
-  const float thickness = static_cast<float>(model_.gel_thickness_mm);
-  for (int r = box.y; r < box.y + box.height; ++r) {
-    const float* __restrict gap = frame_.raster.gap_mm.ptr<float>(r);
-    const float* __restrict followed = followed_.ptr<float>(r);
-    float* __restrict out = h_final_.ptr<float>(r);
-    for (int c = box.x; c < box.x + box.width; ++c) {
-      out[c] = std::min(std::max(followed[c] - gap[c], 0.0f), thickness);
-    }
-  }
-  return stats;
+  return conformity_->applyToFinal(h_sensor, frame_.h_local, overlay_->betaMm(), box, force_n,
+                                   frame_.raster.gap_mm, model_.gel_thickness_mm, h_final_);
 }
 
 }  // namespace norm2tex
