@@ -27,7 +27,8 @@ BUILD = os.path.abspath(sys.argv[2])
 # The programs README names, as `rosrun norm2tex NAME`.
 PROGRAMS = [
     "contact_sim", "tactile_renderer", "probe_sim", "dataset_recorder", "nodelet_group",
-    "norm2tex_bake", "norm2tex_texgen", "norm2tex_render", "norm2tex_calibrate", "norm2tex_export",
+    "norm2tex_bake", "norm2tex_texgen", "norm2tex_render", "norm2tex_calibrate", "norm2tex_match_texture",
+    "norm2tex_export",
     "norm2tex_grasp_demo", "norm2tex_gripper_sweep", "norm2tex_make_demo_normal_map",
     "norm2tex_ros_bench", "norm2tex_wake_bench", "norm2tex_launch_check",
     "record_dataset", "free_port", "merge_dataset", "train_material_classifier", "texture_contrast",
