@@ -92,7 +92,7 @@ class GelConformity {
   std::vector<int> sample_offsets_;     // where the statistics are sampled (scratch)
   std::vector<float> sample_depths_;    // H_sensor there
   cv::Mat1f rise_table_;               // the clipping's mean rise by quantised indentation
-  std::vector<float> row_;             // one row of the followed relief (applyToFinal's scratch)
+  std::vector<float> zeros_;           // a row of zeros: a folded band's, the residual's lower
 
   // apply() and applyToFinal(): with `gap_mm`, H_final goes to `out`, else the followed relief.
   ConformityStats run(const cv::Mat1f& h_sensor_mm, const cv::Mat1f& h_local, double beta_mm,

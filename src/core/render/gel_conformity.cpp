@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/simd_dispatch.hpp"
 
 namespace norm2tex {
 namespace {
@@ -30,6 +31,69 @@ struct BandSums {
   double step_sq_x = 0.0, step_sq_y = 0.0;  // of the squared steps to the next pixel in x, y
   std::array<double, kBins> counts{};
 };
+
+// One row of step 6 (see GelConformity::run): each band clipped at its patch-edge level and
+// summed, the mean rise looked up by the quantised indentation and taken off, and on the
+// renderer's path H_final = clamp(followed - gap, 0, thickness). All three bands in one pass
+// (a band folded into the next reads a row of zeros and a level of -inf, so it adds 0; the
+// residual band's lower level is that row of zeros), so the row's data is read once.
+struct FollowRow {
+  const float* upper[kBands];
+  const float* lower[kBands];
+  float top[kBands], per_mm[kBands], full[kBands];
+  const float* rise;  // the rise table, kRiseEntries entries
+  float levels_per_mm;
+};
+
+NORM2TEX_ALWAYS_INLINE void followRowBody(int n, const FollowRow& a, const float* __restrict h,
+                                          const float* __restrict gap, float thickness,
+                                          float* __restrict out) {
+  const float* __restrict u0 = a.upper[0];
+  const float* __restrict u1 = a.upper[1];
+  const float* __restrict u2 = a.upper[2];
+  const float* __restrict l0 = a.lower[0];
+  const float* __restrict l1 = a.lower[1];
+  const float* __restrict l2 = a.lower[2];
+  const float* __restrict rise = a.rise;
+  for (int c = 0; c < n; ++c) {
+    const float depth = h[c];
+    float sum = 0.0f;
+    sum += std::max(u0[c] - l0[c], a.top[0] - std::min(a.per_mm[0] * depth, a.full[0]));
+    sum += std::max(u1[c] - l1[c], a.top[1] - std::min(a.per_mm[1] * depth, a.full[1]));
+    sum += std::max(u2[c] - l2[c], a.top[2] - std::min(a.per_mm[2] * depth, a.full[2]));
+    const int level =
+        std::min(static_cast<int>(depth * a.levels_per_mm + 0.5f), kRiseEntries - 1);
+    sum -= rise[level];
+    out[c] = gap ? std::min(std::max(sum - gap[c], 0.0f), thickness) : sum;
+  }
+}
+
+using FollowRowFunction = void (*)(int, const FollowRow&, const float*, const float*, float,
+                                   float*);
+
+// Two copies of the loop, so that the compiler hoists the gap test out of each.
+void followRowBaseline(int n, const FollowRow& a, const float* h, const float* gap,
+                       float thickness, float* out) {
+  if (gap) {
+    followRowBody(n, a, h, gap, thickness, out);
+  } else {
+    followRowBody(n, a, h, nullptr, thickness, out);
+  }
+}
+
+#if NORM2TEX_HAS_AVX2_BUILD
+NORM2TEX_TARGET_AVX2 void followRowAvx2(int n, const FollowRow& a, const float* h,
+                                        const float* gap, float thickness, float* out) {
+  if (gap) {
+    followRowBody(n, a, h, gap, thickness, out);
+  } else {
+    followRowBody(n, a, h, nullptr, thickness, out);
+  }
+}
+const FollowRowFunction followRow = pickSimd<FollowRowFunction>(followRowAvx2, followRowBaseline);
+#else
+const FollowRowFunction followRow = followRowBaseline;
+#endif
 
 }  // namespace
 
@@ -301,46 +365,25 @@ ConformityStats GelConformity::run(const cv::Mat1f& h_sensor_mm, const cv::Mat1f
 
   // 6. The followed relief: every band clipped at its edge level, the mean rise taken off
   //    (looked up by the indentation quantised to the table's entries), then, on the renderer's
-  //    path, H_final from it. Band by band over each row, branch-free, so the compiler
-  //    vectorises all but the table look-up.
-  const float levels_per_mm =
-      static_cast<float>((kRiseEntries - 1) / std::max(double(deepest), 1e-9));
-  const float* __restrict rise = rise_table_.ptr<float>();
-  row_.resize(box.width);
+  //    path, H_final from it; one pass over each row (followRow).
+  FollowRow args;
+  zeros_.assign(box.width, 0.0f);
+  for (int k = 0; k < kBands; ++k) {
+    args.top[k] = active[k] ? crest[k] : -std::numeric_limits<float>::infinity();
+    args.per_mm[k] = active[k] ? sink_per_mm[k] : 0.0f;
+    args.full[k] = active[k] ? full_sink[k] : 0.0f;
+  }
+  args.rise = rise_table_.ptr<float>();
+  args.levels_per_mm = static_cast<float>((kRiseEntries - 1) / std::max(double(deepest), 1e-9));
   for (int r = 0; r < box.height; ++r) {
-    const float* __restrict hr = h.ptr<float>(r);
-    float* __restrict out = gap_mm ? row_.data() : out_mm.ptr<float>(box.y + r) + box.x;
-    std::fill(out, out + box.width, 0.0f);
     for (int k = 0; k < kBands; ++k) {
-      if (!active[k]) continue;
-      const float* __restrict upper = smoothed_[fine[k]].ptr<float>(r);
-      const float top = crest[k], per_mm = sink_per_mm[k], full = full_sink[k];
-      // Past p* the level keeps sinking below the band's lowest sample (to a whole range below
-      // it): nothing is clipped. min / max only, so the compiler vectorises the loops.
-      if (coarse[k] == kBands) {
-        for (int c = 0; c < box.width; ++c) {
-          const float level = top - std::min(per_mm * hr[c], full);
-          out[c] += std::max(upper[c], level);
-        }
-        continue;
-      }
-      const float* __restrict lower = smoothed_[coarse[k]].ptr<float>(r);
-      for (int c = 0; c < box.width; ++c) {
-        const float level = top - std::min(per_mm * hr[c], full);
-        out[c] += std::max(upper[c] - lower[c], level);
-      }
+      args.upper[k] = active[k] ? smoothed_[fine[k]].ptr<float>(r) : zeros_.data();
+      args.lower[k] =
+          active[k] && coarse[k] < kBands ? smoothed_[coarse[k]].ptr<float>(r) : zeros_.data();
     }
-    for (int c = 0; c < box.width; ++c) {
-      const int level = static_cast<int>(hr[c] * levels_per_mm + 0.5f);  // hr <= deepest
-      out[c] -= rise[std::min(level, kRiseEntries - 1)];
-    }
-    if (gap_mm) {
-      const float* __restrict gap = gap_mm->ptr<float>(box.y + r) + box.x;
-      float* __restrict h_final = out_mm.ptr<float>(box.y + r) + box.x;
-      for (int c = 0; c < box.width; ++c) {
-        h_final[c] = std::min(std::max(out[c] - gap[c], 0.0f), thickness_mm);
-      }
-    }
+    float* out = out_mm.ptr<float>(box.y + r) + box.x;
+    const float* gap = gap_mm ? gap_mm->ptr<float>(box.y + r) + box.x : nullptr;
+    followRow(box.width, args, h.ptr<float>(r), gap, thickness_mm, out);
   }
   return stats;
 }

@@ -1,7 +1,9 @@
 // Per-frame cost of the DIGIT renderer at 320 x 240 (one core): whole frames with and without
 // texture, a 200k-triangle mesh, and each stage on its own.
+#include <chrono>
 #include <cmath>
 #include <memory>
+#include <thread>
 
 #include <benchmark/benchmark.h>
 
@@ -96,6 +98,28 @@ void BM_Render_Textured_HeldCube_Conformity(benchmark::State& state) {
   renderLoop(state, cube(), 0.2, -1, false, &pose, true);
 }
 
+// The held cube rendered once per 60 Hz tick, as the renderer nodes do: the thread sleeps
+// between frames, so each frame starts with what the idle CPU left of its caches (warm loops
+// miss that). Manual time: the render only. `conformity` 0/1: the fixed-depth overlay or the
+// gel's conformity (the default sensor).
+void BM_Render_HeldCube_Paced60Hz(benchmark::State& state) {
+  norm2tex::SensorModel model = norm2tex::makeDigitSensorModel();
+  model.conformity.enabled = state.range(0) != 0;
+  norm2tex::TactileRenderer renderer(model);
+  renderer.setObject(cube(), atlas(), 0.2);
+  const Eigen::Isometry3d pose = heldCubePose();
+  using Clock = std::chrono::steady_clock;
+  Clock::time_point tick = Clock::now();
+  for (auto _ : state) {
+    tick += std::chrono::nanoseconds(16'666'667);
+    std::this_thread::sleep_until(tick);
+    const Clock::time_point start = Clock::now();
+    const norm2tex::TactileFrame& out = renderer.render(pose, -1);
+    benchmark::DoNotOptimize(out.image.data);
+    state.SetIterationTime(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+}
+
 // --- stages ---------------------------------------------------------------------------------
 // Argument "cube": 0 = the pressed sphere, 1 = the held cube (contact over 3/4 of the gel).
 struct StageFixture {
@@ -167,6 +191,13 @@ BENCHMARK(BM_Render_Textured_HeldCube)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_HeldCube_Conformity)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_Render_HeldCube_Paced60Hz)
+    ->ArgName("conformity")
+    ->Arg(0)
+    ->Arg(1)
+    ->UseManualTime()
+    ->Iterations(180)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Stage_Raster)->ArgNames({"cube", "uv"})->ArgsProduct({{0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Overlay)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Stage_Conformity)->ArgName("cube")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
