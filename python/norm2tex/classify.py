@@ -1,0 +1,272 @@
+"""Material classification from tactile frames: the models and the held-out-variant experiment
+of ``scripts/train_material_classifier`` (needs PyTorch; imported on its own, not by
+``import norm2tex``).
+
+The input is a background-subtracted frame (``ExportedDataset(image="diff")``: float grey
+levels, 3 x 320 x 240 BGR for a QVGA DIGIT), averaged over ``downscale`` x ``downscale`` pixel
+blocks before the network. At 0.053 mm/px a 4x average has 0.21 mm pixels, the period of a
+0.2 mm 3-D print layer: averaging removes every pattern whose period is not longer than the
+block (a 2-px stripe vanishes at 2x and 4x), so ``downscale`` sets what the classifier can see.
+
+    from norm2tex.classify import run
+    result = run("/data/all_png", test_variants=[3], downscale=2)
+    result["overall"]["accuracy"], result["confusion"]
+
+``run`` returns every number as plain Python values (what ``--json`` writes).
+"""
+
+import platform
+import time
+
+import torch
+import torch.nn as nn
+import torch.nn.functional as F
+
+ARCHS = ("small", "resnet18")
+DOWNSCALES = (1, 2, 4)
+# The diff frames are grey-level differences of a few tens; this brings them near unit scale.
+INPUT_SCALE = 32.0
+
+
+class Downscale(nn.Module):
+    """Scales the diff frame to ~unit values and averages it over factor x factor blocks."""
+
+    def __init__(self, factor):
+        super().__init__()
+        if factor not in DOWNSCALES:
+            raise ValueError(f"downscale must be one of {DOWNSCALES}, not {factor!r}")
+        self.factor = factor
+
+    def forward(self, x):
+        x = x / INPUT_SCALE
+        return F.avg_pool2d(x, self.factor) if self.factor > 1 else x
+
+
+class SmallTactileNet(nn.Module):
+    """Three convolutions (16, 32, 64 channels), global average pooling, a linear layer."""
+
+    def __init__(self, classes, downscale=4, channels=3):
+        super().__init__()
+        self.downscale = Downscale(downscale)
+        self.conv1 = nn.Conv2d(channels, 16, 5, padding=2)
+        self.conv2 = nn.Conv2d(16, 32, 3, padding=1)
+        self.conv3 = nn.Conv2d(32, 64, 3, padding=1)
+        self.fc = nn.Linear(64, classes)
+
+    def forward(self, x):
+        x = self.downscale(x)
+        x = F.max_pool2d(F.relu(self.conv1(x)), 2)
+        x = F.max_pool2d(F.relu(self.conv2(x)), 2)
+        x = F.relu(self.conv3(x))
+        return self.fc(x.mean(dim=(2, 3)))
+
+
+class BasicBlock(nn.Module):
+    """ResNet's basic block: two 3x3 convolutions with batch norm and an identity (or a 1x1
+    projection when the shape changes) added before the last ReLU (He et al. 2016)."""
+
+    expansion = 1
+
+    def __init__(self, inplanes, planes, stride=1):
+        super().__init__()
+        self.conv1 = nn.Conv2d(inplanes, planes, 3, stride=stride, padding=1, bias=False)
+        self.bn1 = nn.BatchNorm2d(planes)
+        self.conv2 = nn.Conv2d(planes, planes, 3, padding=1, bias=False)
+        self.bn2 = nn.BatchNorm2d(planes)
+        self.shortcut = None
+        if stride != 1 or inplanes != planes:
+            self.shortcut = nn.Sequential(
+                nn.Conv2d(inplanes, planes, 1, stride=stride, bias=False), nn.BatchNorm2d(planes))
+
+    def forward(self, x):
+        out = F.relu(self.bn1(self.conv1(x)))
+        out = self.bn2(self.conv2(out))
+        identity = x if self.shortcut is None else self.shortcut(x)
+        return F.relu(out + identity)
+
+
+class ResNet18(nn.Module):
+    """ResNet-18 (BasicBlock, [2, 2, 2, 2], 64-512 channels) as torchvision builds it, randomly
+    initialised (no pretrained weights), after the same input averaging as the small net.
+    The paper's classifier architecture; ~11 M parameters, meant for a GPU."""
+
+    def __init__(self, classes, downscale=4, channels=3, layers=(2, 2, 2, 2)):
+        super().__init__()
+        self.downscale = Downscale(downscale)
+        self.conv1 = nn.Conv2d(channels, 64, 7, stride=2, padding=3, bias=False)
+        self.bn1 = nn.BatchNorm2d(64)
+        stages, inplanes = [], 64
+        for i, (planes, blocks) in enumerate(zip((64, 128, 256, 512), layers)):
+            stride = 1 if i == 0 else 2
+            stage = [BasicBlock(inplanes, planes, stride)]
+            stage += [BasicBlock(planes, planes) for _ in range(blocks - 1)]
+            stages.append(nn.Sequential(*stage))
+            inplanes = planes
+        self.layer1, self.layer2, self.layer3, self.layer4 = stages
+        self.fc = nn.Linear(512 * BasicBlock.expansion, classes)
+        for m in self.modules():
+            if isinstance(m, nn.Conv2d):
+                nn.init.kaiming_normal_(m.weight, mode="fan_out", nonlinearity="relu")
+            elif isinstance(m, nn.BatchNorm2d):
+                nn.init.ones_(m.weight)
+                nn.init.zeros_(m.bias)
+
+    def forward(self, x):
+        x = self.downscale(x)
+        x = F.max_pool2d(F.relu(self.bn1(self.conv1(x))), 3, stride=2, padding=1)
+        x = self.layer4(self.layer3(self.layer2(self.layer1(x))))
+        return self.fc(x.mean(dim=(2, 3)))
+
+
+def build_model(arch, classes, downscale=4, channels=3):
+    """The named architecture ("small" or "resnet18") for `classes` classes."""
+    if arch == "small":
+        return SmallTactileNet(classes, downscale, channels)
+    if arch == "resnet18":
+        return ResNet18(classes, downscale, channels)
+    raise ValueError(f"unknown arch {arch!r}: choose one of {', '.join(ARCHS)}")
+
+
+def resolve_device(device):
+    """"auto" -> "cuda" when PyTorch sees a GPU, else "cpu"; "cuda" without one is an error."""
+    if device == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if device == "cuda" and not torch.cuda.is_available():
+        raise RuntimeError("--device cuda, but PyTorch sees no CUDA GPU (torch.cuda.is_available()"
+                           " is False); use --device cpu or auto")
+    if device not in ("cpu", "cuda"):
+        raise ValueError(f"device must be auto, cpu or cuda, not {device!r}")
+    return device
+
+
+def split(export_dir, test_variants):
+    """(train, test, classes): ExportedDataset of the variants not held out and of the held-out
+    ones. Raises ValueError when no frame is held out or no variant is left to train on."""
+    from norm2tex_dataset import ExportedDataset
+
+    held_out = sorted(set(int(v) for v in test_variants))
+    everything = ExportedDataset(export_dir, image="diff")
+    variants = sorted({r["variant"] for r in everything.rows})
+    train_variants = [v for v in variants if v not in held_out]
+    if not any(v in variants for v in held_out):
+        raise ValueError(f"no frames of the held-out variants {held_out} in {export_dir} "
+                         f"(it holds variants {variants})")
+    if not train_variants:
+        raise ValueError(f"no variant left to train on: {export_dir} holds only variants "
+                         f"{variants}, all held out; record more variants")
+    train = ExportedDataset(export_dir, image="diff", variants=train_variants)
+    test = ExportedDataset(export_dir, image="diff", variants=held_out)
+    # Both splits index classes by the full dataset's materials, so their targets agree.
+    return train, test, everything.classes
+
+
+def _per_material(dataset, classes):
+    counts = {c: 0 for c in classes}
+    for row in dataset.rows:
+        counts[row["material"]] += 1
+    return counts
+
+
+def confusion_matrix(model, loader, classes, device):
+    """confusion[true][predicted] counts over the loader."""
+    model.eval()
+    confusion = [[0] * classes for _ in range(classes)]
+    with torch.no_grad():
+        for images, targets in loader:
+            predicted = model(images.to(device)).argmax(1).cpu()
+            for p, t in zip(predicted.tolist(), targets.tolist()):
+                confusion[t][p] += 1
+    return confusion
+
+
+def run(export_dir, test_variants=(3,), epochs=12, seed=0, downscale=4, arch="small",
+        device="auto", threads=2, batch_size=32, lr=2e-3, workers=2, log=print):
+    """Trains `arch` on the variants not in `test_variants`, tests on those, returns a dict of
+    settings, frame counts, per-epoch loss and training accuracy, the confusion matrix
+    (rows: true material, columns: predicted), per-material and overall held-out accuracy and
+    the training wall time. The same seed gives the same result on the same machine (model
+    initialisation and the shuffled data order both come from it)."""
+    if arch not in ARCHS:
+        raise ValueError(f"unknown arch {arch!r}: choose one of {', '.join(ARCHS)}")
+    if downscale not in DOWNSCALES:
+        raise ValueError(f"downscale must be one of {DOWNSCALES}, not {downscale!r}")
+    device = resolve_device(device)
+    if threads:
+        torch.set_num_threads(threads)
+    torch.manual_seed(seed)
+    torch.use_deterministic_algorithms(True, warn_only=True)
+    if device == "cuda":
+        torch.backends.cudnn.benchmark = False
+    train, test, classes = split(export_dir, test_variants)
+    train_variants = sorted({r["variant"] for r in train.rows})
+    held_out = sorted({r["variant"] for r in test.rows})
+    log(f"{len(train)} training frames (variants {train_variants}), {len(test)} held-out "
+        f"(variants {held_out}); classes {classes}; {arch}, {downscale}x averaging, {device}")
+    order = torch.Generator().manual_seed(seed)
+    pin = device == "cuda"
+    train_loader = torch.utils.data.DataLoader(train, batch_size=batch_size, shuffle=True,
+                                               generator=order, num_workers=workers,
+                                               pin_memory=pin)
+    test_loader = torch.utils.data.DataLoader(test, batch_size=64, num_workers=workers,
+                                              pin_memory=pin)
+    model = build_model(arch, len(classes), downscale).to(device)
+    optimiser = torch.optim.Adam(model.parameters(), lr=lr)
+    history = []
+    start = time.time()
+    for epoch in range(epochs):
+        model.train()
+        loss_sum, right, seen = 0.0, 0, 0
+        for images, targets in train_loader:
+            images, targets = images.to(device), targets.to(device)
+            optimiser.zero_grad()
+            logits = model(images)
+            loss = F.cross_entropy(logits, targets)
+            loss.backward()
+            optimiser.step()
+            loss_sum += loss.item() * len(targets)
+            right += (logits.argmax(1) == targets).sum().item()
+            seen += len(targets)
+        history.append({"epoch": epoch + 1, "loss": loss_sum / seen, "train_accuracy": right / seen})
+        log(f"epoch {epoch + 1:2d}: loss {loss_sum / seen:.3f}, training accuracy "
+            f"{right / seen:.3f} ({time.time() - start:.0f} s)")
+    train_time = time.time() - start
+    confusion = confusion_matrix(model, test_loader, len(classes), device)
+    per_material = {}
+    for i, name in enumerate(classes):
+        total = sum(confusion[i])
+        per_material[name] = {"correct": confusion[i][i], "total": total,
+                              "accuracy": confusion[i][i] / total if total else None}
+    correct = sum(confusion[i][i] for i in range(len(classes)))
+    total = sum(map(sum, confusion))
+    sample, _ = test[0]
+    return {
+        "settings": {
+            "export_dir": str(export_dir), "arch": arch, "downscale": downscale,
+            "input_size": [sample.shape[1] // downscale, sample.shape[2] // downscale],
+            "frame_size": list(sample.shape[1:]), "epochs": epochs, "seed": seed,
+            "test_variants": held_out, "train_variants": train_variants, "device": device,
+            "threads": torch.get_num_threads(), "batch_size": batch_size, "lr": lr,
+            "workers": workers, "parameters": sum(p.numel() for p in model.parameters()),
+            "torch": torch.__version__, "machine": platform.node(),
+        },
+        "classes": classes,
+        "frames": {"train": len(train), "test": len(test),
+                   "train_per_material": _per_material(train, classes),
+                   "test_per_material": _per_material(test, classes)},
+        "history": history,
+        "confusion": confusion,
+        "per_material": per_material,
+        "overall": {"correct": correct, "total": total, "accuracy": correct / total},
+        "chance": 1.0 / len(classes),
+        "train_time_s": train_time,
+    }
+
+
+def format_confusion(result):
+    """The confusion matrix as text: rows the true material, columns the predicted one."""
+    classes = result["classes"]
+    width = max(8, max(len(c) for c in classes) + 1)
+    lines = ["true \\ predicted".ljust(width) + "".join(c[:width - 1].rjust(width) for c in classes)]
+    for name, row in zip(classes, result["confusion"]):
+        lines.append(name.ljust(width) + "".join(str(n).rjust(width) for n in row))
+    return "\n".join(lines)
