@@ -45,13 +45,27 @@ TactileBagReader::TactileBagReader(std::vector<std::string> bag_paths)
 std::uint64_t TactileBagReader::forEachSample(
     const std::function<void(const TactileSample&)>& visit) {
   // Which per-frame topics each sensor has, over all bags: a frame waits for exactly those.
+  // And every background first (a small latched topic, read through the bag index): the
+  // recorder may store it after the first frames of its sensor, which must not be handed over
+  // without it.
   std::map<std::string, std::set<std::string>> leaves;
   for (const std::string& path : paths_) {
     rosbag::Bag bag(path, rosbag::bagmode::Read);
-    rosbag::View view(bag);
-    for (const rosbag::ConnectionInfo* c : view.getConnections()) {
-      const auto [sensor, leaf] = splitTopic(c->topic);
-      if (leaf == "image_raw" || leaf == "depth" || leaf == "contact") leaves[sensor].insert(leaf);
+    std::vector<std::string> background_topics;
+    {
+      rosbag::View view(bag);
+      for (const rosbag::ConnectionInfo* c : view.getConnections()) {
+        const auto [sensor, leaf] = splitTopic(c->topic);
+        if (leaf == "image_raw" || leaf == "depth" || leaf == "contact") leaves[sensor].insert(leaf);
+        if (leaf == "background") background_topics.push_back(c->topic);
+      }
+    }
+    if (background_topics.empty()) continue;
+    rosbag::View view(bag, rosbag::TopicQuery(background_topics));
+    for (const rosbag::MessageInstance& m : view) {
+      if (auto image = m.instantiate<sensor_msgs::Image>()) {
+        backgrounds_[splitTopic(m.getTopic()).first] = ros_conversions::fromImageMsg(*image);
+      }
     }
   }
   // Every episode label first (a small topic, read through the bag index): an episode message
@@ -95,13 +109,7 @@ std::uint64_t TactileBagReader::forEachSample(
       const ros::Time bag_time = m.getTime();
       emitReady(&bag_time);
       const auto [sensor, leaf] = splitTopic(m.getTopic());
-      if (leaf == "episode") continue;  // read above
-      if (leaf == "background") {
-        if (auto image = m.instantiate<sensor_msgs::Image>()) {
-          backgrounds_[sensor] = ros_conversions::fromImageMsg(*image);
-        }
-        continue;
-      }
+      if (leaf == "episode" || leaf == "background") continue;  // read above
       if (leaf != "image_raw" && leaf != "depth" && leaf != "contact") continue;
       ros::Time stamp;
       TactileContact::ConstPtr contact;

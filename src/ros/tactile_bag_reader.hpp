@@ -44,7 +44,7 @@ class TactileBagReader {
   std::uint64_t forEachSample(const std::function<void(const TactileSample&)>& visit);
 
   /// Each sensor's no-contact background (the renderer's latched <sensor>/background), once
-  /// forEachSample has read past it; sensors without one are absent.
+  /// forEachSample has started (it reads them before any frame); sensors without one are absent.
   const std::map<std::string, cv::Mat3b>& backgrounds() const { return backgrounds_; }
 
  private:

@@ -13,10 +13,12 @@
 #include <tuple>
 
 #include <gtest/gtest.h>
+#include <rosbag/bag.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "../core/test_helpers.hpp"
+#include "conversions.hpp"
 #include "dataset_export.hpp"
 #include "norm2tex/common/error.hpp"
 #include "run_node.hpp"
@@ -342,6 +344,38 @@ TEST_F(ProbeDataset, ExportRoundTripsFramesLabelsAndBackgroundSubtraction) {
   ExportOptions elsewhere;
   elsewhere.out_dir = (scratch() / "export2").string();
   test::expectError([&] { exportDataset({fake.string()}, elsewhere); }, {"fake.bag", "not a readable bag"});
+}
+
+// A background stored after its sensor's first frames (the recorder writes the latched
+// background when it arrives, which can be after the renderer's first images): every frame is
+// handed over with its sensor's background already read, and the export subtracts it.
+TEST(TactileBagReader, ABackgroundStoredAfterTheFirstFramesIsReadBeforeThem) {
+  const fs::path dir = scratch() / "late_background";
+  fs::create_directories(dir);
+  const std::string bag_path = (dir / "late.bag").string();
+  const cv::Mat3b background(320, 240, cv::Vec3b(90, 100, 110));
+  {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Write);
+    std_msgs::Header header;
+    header.frame_id = "digit_left_gel";
+    for (int i = 0; i < 3; ++i) {
+      header.stamp = ros::Time(1.0 + i / 60.0);
+      const cv::Mat3b frame(320, 240, cv::Vec3b(100 + i, 100, 100));
+      bag.write("/digit_left/image_raw", header.stamp, *ros_conversions::toImageMsg(header, frame));
+    }
+    header.stamp = ros::Time(2.0);  // after every frame, in the bag's time and order
+    bag.write("/digit_left/background", header.stamp,
+              *ros_conversions::toImageMsg(header, background));
+  }
+  TactileBagReader reader({bag_path});
+  int visited = 0;
+  reader.forEachSample([&](const TactileSample& sample) {
+    ++visited;
+    const auto it = reader.backgrounds().find(sample.sensor);
+    ASSERT_NE(it, reader.backgrounds().end()) << "frame " << visited << " before its background";
+    EXPECT_EQ(cv::norm(it->second, background, cv::NORM_INF), 0.0);
+  });
+  EXPECT_EQ(visited, 3);
 }
 
 }  // namespace
