@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -31,6 +32,47 @@ struct BandSums {
   double step_sq_x = 0.0, step_sq_y = 0.0;  // of the squared steps to the next pixel in x, y
   std::array<double, kBins> counts{};
 };
+
+// Step 1's sums over one row of the indentation: its sum, the pixels in contact and the deepest,
+// in eight lanes of floats (the counts are exact: a lane counts at most a row's 1/8). Written
+// with GCC vector types: the loop vectoriser leaves a float sum alone (it may not reorder it) and
+// does not vectorise lanes in arrays, and both builds then add in the same order.
+constexpr int kLanes = 8;
+typedef float Lanes __attribute__((vector_size(kLanes * sizeof(float))));
+struct ContactLanes {
+  Lanes sum, count, top;
+};
+
+NORM2TEX_ALWAYS_INLINE void contactRowBody(int n, const float* __restrict row, ContactLanes& out) {
+  Lanes sum = {}, count = {}, top = {};
+  const Lanes zero = {};
+  int c = 0;
+  for (; c + kLanes <= n; c += kLanes) {
+    Lanes depth;
+    std::memcpy(&depth, row + c, sizeof depth);
+    sum += depth;
+    count -= __builtin_convertvector(depth > zero, Lanes);  // true is -1
+    top = depth > top ? depth : top;
+  }
+  for (; c < n; ++c) {  // the row's tail in lane 0
+    sum[0] += row[c];
+    count[0] += row[c] > 0.0f ? 1.0f : 0.0f;
+    top[0] = std::max(top[0], row[c]);
+  }
+  out = {sum, count, top};
+}
+
+using ContactRowFunction = void (*)(int, const float*, ContactLanes&);
+void contactRowBaseline(int n, const float* row, ContactLanes& out) { contactRowBody(n, row, out); }
+#if NORM2TEX_HAS_AVX2_BUILD
+NORM2TEX_TARGET_AVX2 void contactRowAvx2(int n, const float* row, ContactLanes& out) {
+  contactRowBody(n, row, out);
+}
+const ContactRowFunction contactRow =
+    pickSimd<ContactRowFunction>(contactRowAvx2, contactRowBaseline);
+#else
+const ContactRowFunction contactRow = contactRowBaseline;
+#endif
 
 // One row of step 6 (see GelConformity::run): each band clipped at its patch-edge level and
 // summed, the mean rise looked up by the quantised indentation and taken off, and on the
@@ -152,32 +194,13 @@ ConformityStats GelConformity::run(const cv::Mat1f& h_sensor_mm, const cv::Mat1f
   double indentation_sum = 0.0;
   long contact_pixels = 0;
   float deepest = 0.0f;
-  {
-    // One pass, in eight lanes the compiler vectorises (a plain float sum it may not reorder).
-    constexpr int kLanes = 8;
-    for (int r = 0; r < h.rows; ++r) {
-      const float* row = h.ptr<float>(r);
-      float sum[kLanes] = {}, top[kLanes] = {};
-      int count[kLanes] = {};
-      int c = 0;
-      for (; c + kLanes <= h.cols; c += kLanes) {
-        for (int j = 0; j < kLanes; ++j) {
-          const float depth = row[c + j];
-          sum[j] += depth;
-          count[j] += depth > 0.0f ? 1 : 0;
-          top[j] = std::max(top[j], depth);
-        }
-      }
-      for (; c < h.cols; ++c) {
-        sum[0] += row[c];
-        count[0] += row[c] > 0.0f ? 1 : 0;
-        top[0] = std::max(top[0], row[c]);
-      }
-      for (int j = 0; j < kLanes; ++j) {
-        indentation_sum += sum[j];
-        contact_pixels += count[j];
-        deepest = std::max(deepest, top[j]);
-      }
+  for (int r = 0; r < h.rows; ++r) {
+    ContactLanes lanes;
+    contactRow(h.cols, h.ptr<float>(r), lanes);
+    for (int j = 0; j < kLanes; ++j) {
+      indentation_sum += lanes.sum[j];
+      contact_pixels += static_cast<long>(lanes.count[j]);
+      deepest = std::max(deepest, lanes.top[j]);
     }
   }
   const double pixel_area = mm_per_pixel_ * mm_per_pixel_;
