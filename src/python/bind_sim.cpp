@@ -255,8 +255,10 @@ void bindSim(py::module& m) {
           "Starts an episode of gripper `index` (texture variant first; < 0 keeps it) and renders "
           "its first frame. Returns a dict (episode, seed, height_offset_m, grasp_opening).")
       .def("prefetch_variant",
-           [](TactileGripperBatch& b, int variant) { b.gripper(0).prefetchVariant(variant); },
-           py::arg("variant"), "Generates a texture variant in the background for all grippers.")
+           [](TactileGripperBatch& b, int variant, int i) { b.gripper(i).prefetchVariant(variant); },
+           py::arg("variant"), py::arg("index") = 0,
+           "Generates a texture variant of gripper `index`'s material in the background, for "
+           "every gripper of the batch with that material.")
       .def("images", [](const TactileGripperBatch& b, const std::string& finger) {
              return stackImages(b, fingerFrom(finger));
            }, py::arg("finger"), "(N, rows, cols, 3) uint8 bgr8 frames of one sensor")

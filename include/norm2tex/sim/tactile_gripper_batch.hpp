@@ -20,7 +20,8 @@ enum class OpeningCommand {
 /// renders its two sensors in parallel. Each gripper gives exactly what it gives alone: the
 /// threads only decide where a gripper's own work runs.
 ///
-/// The grippers share one texture cache: a material variant is generated once for all.
+/// The grippers share one texture cache: a material variant is generated once for all. Each
+/// gripper may have its own material (options); the cache keeps 32 variants per material.
 class TactileGripperBatch {
  public:
   /// One gripper per entry of `options`. `threads` as ParallelFor (0: the machine's CPUs).

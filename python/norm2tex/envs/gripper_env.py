@@ -47,6 +47,8 @@ class GripperVectorEnv(spaces.EnvBase):
     Parameters (every one also of GripperEnv):
       num_envs: N (>= 1).
       material: config/materials/<name>.yaml name or a path; None: no texture, friction 0.5.
+        In-process also a list of N, one per environment (each its own friction and texture;
+        variants then index every one of them); info["material"] says which.
       variant: an int, or a list of variants drawn from uniformly per episode (the paper uses
         24: variants=range(24)); None = range(the material's variant_count).
       beta_mm: texture depth, mm (None: the material's; 0: the textureless sensor).
@@ -132,6 +134,8 @@ class GripperVectorEnv(spaces.EnvBase):
                 threads=threads,
             )
         elif backend == "ros":
+            if isinstance(material, (list, tuple)):
+                raise ValueError("backend 'ros' runs one material: give a name, not a list")
             if self.num_envs != 1:
                 raise ValueError("backend 'ros' drives one running gripper: num_envs must be 1")
             from norm2tex.envs.ros_backend import RosBackend
@@ -148,6 +152,16 @@ class GripperVectorEnv(spaces.EnvBase):
         if not self.variants or min(self.variants) < 0:
             raise ValueError("variant(s) %r; valid: ints >= 0" % (variant,))
         self._episodes = [_Episode() for _ in range(self.num_envs)]
+        # Per environment: its material's name (None: no texture), friction and texture depth.
+        materials = (list(material) if isinstance(material, (list, tuple))
+                     else [material] * self.num_envs)
+        self.materials = [os.path.splitext(os.path.basename(m))[0] if m else None
+                          for m in materials]
+        n = self.num_envs
+        self.frictions = [float(f) for f in getattr(self.backend, "frictions",
+                                                    [self.backend.friction] * n)]
+        self.betas_mm = [float(b) for b in getattr(self.backend, "betas_mm",
+                                                   [self.backend.beta_mm] * n)]
         self._backgrounds = {f: self.backend.background(f) for f in FINGERS}
 
         self.single_observation_space = self._single_observation_space()
@@ -274,6 +288,10 @@ class GripperVectorEnv(spaces.EnvBase):
     def _reward(self, state, i):
         return 0.0
 
+    def _terminated(self, state, i):
+        """Whether environment i's episode ends at this step: the object dropped."""
+        return bool(state["dropped"][i])
+
     def _after_reset(self, i, rng):
         """Called after the simulator's reset of environment i: returns (mode, value, frames),
         a command environment i alone is stepped with before its first observation, or None."""
@@ -303,6 +321,9 @@ class GripperVectorEnv(spaces.EnvBase):
         command = self._after_reset(i, rng)
         episode.steps = 0
         episode.info = {
+            "material": self.materials[i],
+            "friction": self.frictions[i],
+            "beta_mm": self.betas_mm[i],
             "start_opening": float(command[1]) if command else float("nan"),
             "episode": int(start["episode"]),
             "seed": sim_seed,
@@ -378,7 +399,7 @@ class GripperVectorEnv(spaces.EnvBase):
         truncated = np.zeros(self.num_envs, dtype=bool)
         for i in range(self.num_envs):
             self._episodes[i].steps += 1
-            terminated[i] = bool(state["dropped"][i])
+            terminated[i] = self._terminated(state, i)
             rewards[i] = 0.0 if terminated[i] else self._reward(state, i)
             truncated[i] = (
                 not terminated[i]

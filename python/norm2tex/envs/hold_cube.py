@@ -8,6 +8,11 @@ policy then changes the opening by -0.005 / 0 / +0.005 per step. Reward per step
 scaled sigmoid of the opening command (0 at 0.5, 1/2 at 0.6, 1 at 0.7: opening wider is a
 lighter grip), 0 and termination when the cube drops; truncated after 128 steps. A texture
 variant is drawn per episode from the material's 24.
+
+With empty=True the gripper holds nothing: after the grasp it opens wide until the cube has
+fallen to the floor, out of the sensors' reach, then the episode starts as usual (the command in
+[0.45, 0.55]) and runs its 128 steps with the same reward and no drop to end it -- what a policy
+does with an empty gripper.
 """
 
 import math
@@ -18,6 +23,9 @@ from norm2tex.envs.gripper_env import GripperEnv, GripperVectorEnv
 from norm2tex.envs.inprocess_backend import ABSOLUTE
 
 HORIZON = 128
+# empty=True: frames the gripper stays fully open after the grasp, for the cube to fall clear of
+# the gels (it falls ~0.2 m to the floor; `dropped` once it is below the gels' lower edge).
+EMPTY_DROP_FRAMES = 30
 START_OPENING = (0.45, 0.55)
 REWARD_LOW, REWARD_MID, REWARD_HIGH = 0.5, 0.6, 0.7
 # Steepness of the sigmoid, per unit of opening: 5 / 0.1, so that the unscaled curve has
@@ -39,16 +47,26 @@ def hold_reward(opening):
 
 
 class HoldCubeVectorEnv(GripperVectorEnv):
-    """N HoldCubeEnvs stepped together (see GripperVectorEnv)."""
+    """N HoldCubeEnvs stepped together (see GripperVectorEnv). empty=True: no object in the
+    gripper (the cube is dropped before each episode starts; no termination)."""
 
     def __init__(self, num_envs=1, material="wood", variant=None, scene="hold_cube",
-                 max_episode_steps=HORIZON, grasp_frames=15, **kwargs):
+                 max_episode_steps=HORIZON, grasp_frames=15, empty=False, **kwargs):
         self.grasp_frames = int(grasp_frames)
+        self.empty = bool(empty)
         super().__init__(num_envs=num_envs, material=material, variant=variant, scene=scene,
                          max_episode_steps=max_episode_steps, **kwargs)
 
     def _after_reset(self, i, rng):
+        if self.empty:
+            self.backend.step_one(i, ABSOLUTE, 1.0, EMPTY_DROP_FRAMES)
+            if not self.backend.state()["dropped"][i]:
+                raise RuntimeError("empty gripper: the cube was still held after %d frames fully "
+                                   "open" % EMPTY_DROP_FRAMES)
         return (ABSOLUTE, float(rng.uniform(*START_OPENING)), self.grasp_frames)
+
+    def _terminated(self, state, i):
+        return False if self.empty else super()._terminated(state, i)
 
     def _reward(self, state, i):
         return hold_reward(state["commanded_opening"][i])

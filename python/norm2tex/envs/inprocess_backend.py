@@ -31,7 +31,9 @@ class InProcessBackend:
       close()
 
     Parameters are contact_sim's and tactile_renderer's (same names, same defaults), so the same
-    choices give the same frames as gripper_sim.launch.
+    choices give the same frames as gripper_sim.launch. `material` may also be a list, one per
+    gripper (then friction, beta and texture are each gripper's own: frictions, betas_mm);
+    variant_count is then the smallest of the materials'.
     """
 
     def __init__(
@@ -54,11 +56,16 @@ class InProcessBackend:
         sensor_model = norm2tex.SensorModel.load(sensor or norm2tex.config_path("digit.yaml"))
         scene_config = norm2tex.SceneConfig.load(norm2tex.scene_config(scene))
         options = []
-        material_path = norm2tex.material_config(material) if material else ""
-        self.variant_count = (
-            norm2tex.MaterialConfig.load(material_path).variant_count if material_path else 1
-        )
-        for _ in range(count):
+        # One material for all grippers, or a list of one per gripper.
+        materials = list(material) if isinstance(material, (list, tuple)) else [material] * count
+        if len(materials) != count:
+            raise ValueError("%d materials for %d grippers; valid: one, or one per gripper"
+                             % (len(materials), count))
+        paths = [norm2tex.material_config(m) if m else "" for m in materials]
+        counts = [norm2tex.MaterialConfig.load(p).variant_count if p else 1 for p in paths]
+        # The variants every gripper's material has (an environment draws from one list).
+        self.variant_count = min(c for c, p in zip(counts, paths) if p) if any(paths) else 1
+        for material_path in paths:
             o = norm2tex.TactileGripperOptions()
             o.material_config = material_path
             o.variant = int(variant)
@@ -73,26 +80,31 @@ class InProcessBackend:
             options.append(o)
         self.batch = norm2tex.TactileGripperBatch(scene_config, sensor_model, options, threads)
         self.size = count
-        self.has_material = bool(material_path)
+        self.has_materials = [bool(p) for p in paths]
+        self.has_material = any(self.has_materials)
         # Noise drawn per episode from a seed the environment gives (set_noise_seed).
         self.noise_per_episode = bool(noise_per_episode)
         self.frame_seconds = self.batch.frame_seconds
         self.height_offset_range = self.batch.sim(0).height_offset_range
         self.beta_mm = self.batch.beta_mm(0)
         self.friction = self.batch.friction(0)
+        # Per gripper (they differ when the materials do).
+        self.betas_mm = [self.batch.beta_mm(i) for i in range(count)]
+        self.frictions = [self.batch.friction(i) for i in range(count)]
         self._backgrounds = {f: self.batch.background(f) for f in ("left", "right")}
 
     def reset(self, i, seed, height_offset_m=None, variant=None, next_variant=None):
         offset = None if height_offset_m is None or math.isnan(height_offset_m) else height_offset_m
-        if not self.has_material:
+        if not self.has_materials[i]:
             variant = next_variant = None  # no texture to vary
         start = self.batch.reset(i, int(seed), offset, -1 if variant is None else int(variant))
         if next_variant is not None:
-            self.batch.prefetch_variant(int(next_variant))  # generated while this episode runs
+            # Generated (for gripper i's material) while this episode runs.
+            self.batch.prefetch_variant(int(next_variant), i)
         return start
 
-    def prefetch_variant(self, variant):
-        self.batch.prefetch_variant(int(variant))
+    def prefetch_variant(self, variant, i=0):
+        self.batch.prefetch_variant(int(variant), i)
 
     def set_noise_seed(self, i, noise_seed):
         self.batch.set_noise_seed(i, -1 if noise_seed is None else int(noise_seed))

@@ -1,6 +1,8 @@
 #include "norm2tex/sim/tactile_gripper_batch.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 #include <string>
 
 #include "norm2tex/common/error.hpp"
@@ -8,15 +10,22 @@
 namespace norm2tex {
 namespace {
 
-/// Variants the batch keeps generated: the paper's 24 per material, with room.
+/// Variants the batch keeps generated, per material of its grippers: the paper's 24, with room.
 constexpr std::size_t kKeptVariants = 32;
+
+/// The cache's capacity: kKeptVariants for each distinct material of the grippers.
+std::size_t keptVariants(const std::vector<TactileGripperOptions>& options) {
+  std::set<std::string> materials;
+  for (const TactileGripperOptions& o : options) materials.insert(o.material_config);
+  return kKeptVariants * std::max<std::size_t>(1, materials.size());
+}
 
 }  // namespace
 
 TactileGripperBatch::TactileGripperBatch(const GripperSimConfig& scene, const SensorModel& sensor,
                                          const std::vector<TactileGripperOptions>& options,
                                          int threads)
-    : textures_(std::make_shared<ObjectTextureCache>(kKeptVariants)), pool_(threads) {
+    : textures_(std::make_shared<ObjectTextureCache>(keptVariants(options))), pool_(threads) {
   if (options.empty()) throw Error("a batch needs at least one gripper");
   grippers_.reserve(options.size());
   for (const TactileGripperOptions& o : options) {

@@ -1,0 +1,186 @@
+"""scripts/hold_cube_experiment (norm2tex.rl.hold_cube_experiment): the quick run end to end
+with every output, its numbers in range, the same numbers for the same seed; the environments it
+needs: a batch with one material per environment, and the empty gripper."""
+
+import csv
+import json
+import math
+import os
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch", reason="PyTorch is not installed (Debian: python3-torch)")
+
+import norm2tex  # noqa: E402
+from norm2tex.envs import HoldCubeEnv, HoldCubeVectorEnv, hold_reward  # noqa: E402
+from norm2tex.rl import hold_cube_experiment as hce  # noqa: E402
+
+MATERIALS = ["wood", "fabric", "smooth"]
+
+
+def assert_obs_equal(a, b):
+    assert a.keys() == b.keys()
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+
+
+def test_each_environment_of_a_batch_runs_its_own_material():
+    kwargs = dict(variant=[3, 21], image="diff_int16", downscale=4, force=True)
+    batch = HoldCubeVectorEnv(num_envs=3, material=MATERIALS, **kwargs)
+    obs, infos = batch.reset(seed=40)
+    steps = [batch.step([2, 1, 0])[0] for _ in range(3)]
+    for i, m in enumerate(MATERIALS):
+        config = norm2tex.MaterialConfig.load(norm2tex.material_config(m))
+        assert infos[i]["material"] == m
+        assert infos[i]["friction"] == pytest.approx(config.friction)
+        assert infos[i]["beta_mm"] == pytest.approx(config.beta_mm)
+        # Its images are that material's texture: what an environment of that material alone
+        # renders for the same seed and actions, bit for bit.
+        single = HoldCubeEnv(material=m, **kwargs)
+        first, info = single.reset(seed=40 + i)
+        assert info["variant"] == infos[i]["variant"]
+        assert_obs_equal(first, {k: v[i] for k, v in obs.items()})
+        for t in range(3):
+            o = single.step([2, 1, 0][i])[0]
+            assert_obs_equal(o, {k: v[i] for k, v in steps[t].items()})
+        single.close()
+    # The three frictions differ, and so do the images (textures) of the same grasp.
+    assert len({info["friction"] for info in infos}) == 3
+    batch.close()
+    # Textureless: every material's beta is 0, its friction stays the material's.
+    flat = HoldCubeVectorEnv(num_envs=3, material=MATERIALS, beta_mm=0.0, **kwargs)
+    _, infos = flat.reset(seed=40)
+    assert [i["beta_mm"] for i in infos] == [0.0, 0.0, 0.0]
+    assert infos[1]["friction"] == pytest.approx(0.6)
+    flat.close()
+    with pytest.raises(ValueError, match="materials for"):
+        HoldCubeVectorEnv(num_envs=2, material=MATERIALS)
+
+
+def test_the_empty_gripper_holds_nothing_and_never_drops():
+    env = HoldCubeVectorEnv(num_envs=2, empty=True, image="diff_int16", downscale=4,
+                            max_episode_steps=6)
+    obs, infos = env.reset(seed=1)
+    assert all(i["dropped"] for i in infos)  # the cube lies on the floor
+    assert np.all(obs["force"] == 0.0)
+    assert np.all((obs["opening"] >= 0.45) & (obs["opening"] <= 0.55))
+    # Nothing touches the gels: the frames are the background (up to the sensor's noise).
+    assert np.abs(obs["digit_left"]).mean() < 3.0
+    for t in range(6):
+        obs, rewards, terminated, truncated, infos = env.step([2, 2])
+        assert not terminated.any()
+        for i in range(2):  # the paper's reward of the opening, as with the cube
+            last = infos[i]["final_observation"] if truncated[i] else {"opening": obs["opening"][i]}
+            assert rewards[i] == pytest.approx(hold_reward(last["opening"][0]), abs=1e-5)
+    assert truncated.all()
+    env.close()
+    # The same task with the cube: opening wide drops it and ends the episode.
+    held = HoldCubeVectorEnv(num_envs=1, image="diff_int16", downscale=4)
+    obs, infos = held.reset(seed=1)
+    assert not infos[0]["dropped"] and obs["force"].min() > 1.0
+    held.close()
+
+
+def _check_outputs(out, results, config):
+    for name in ["results.json", "results.csv", "opening_vs_step.png", "training_curves.png"] + [
+            "training_%s.csv" % c for c in config.conditions] + [
+            "policy_%s.pt" % c for c in config.conditions]:
+        assert os.path.getsize(os.path.join(out, name)) > 0, name
+    with open(os.path.join(out, "results.json")) as f:
+        assert json.load(f) == results
+    thresholds = results["thresholds"]
+    assert list(thresholds) == list(config.materials)
+    for t in thresholds.values():
+        assert isinstance(t, float) and 0.55 <= t <= 0.7
+    sorted(thresholds.values())
+    assert list(results["policies"]) == list(config.conditions)
+    rows = list(csv.DictReader(open(os.path.join(out, "results.csv"))))
+    for p, entry in results["policies"].items():
+        assert entry["training"] and entry["training"][-1]["steps"] > 0
+        assert list(entry["evaluation"]) == list(config.materials) + (
+            ["empty"] if config.eval_empty else [])
+        for m, ev in entry["evaluation"].items():
+            assert set(ev) == {"episodes", "opening_mean", "opening_std", "held_fraction",
+                               "final_opening_mean", "final_opening_std", "drop_rate",
+                               "return_mean", "return_std"}
+            assert ev["episodes"] == config.eval_episodes
+            for k in ("opening_mean", "opening_std", "held_fraction"):
+                assert len(ev[k]) == config.horizon + 1
+            values = ev["opening_mean"] + ev["opening_std"] + ev["held_fraction"] + [
+                ev[k] for k in ("final_opening_mean", "final_opening_std", "drop_rate",
+                                "return_mean", "return_std")]
+            assert all(isinstance(v, float) and math.isfinite(v) for v in values), (p, m)
+            assert 0.0 <= ev["drop_rate"] <= 1.0
+            assert all(0.0 <= v <= 1.0 for v in ev["opening_mean"] + ev["held_fraction"])
+            assert 0.0 <= ev["final_opening_mean"] <= 1.0
+            assert 0.0 <= ev["return_mean"] <= config.horizon
+            if m == "empty":
+                assert ev["drop_rate"] == 0.0
+            # Every number of the JSON is a row of the CSV.
+            mine = {(r["metric"], r["step"]): float(r["value"]) for r in rows
+                    if r["policy"] == p and r["material"] == m}
+            assert mine[("drop_rate", "")] == ev["drop_rate"]
+            assert mine[("opening_mean", str(config.horizon))] == ev["opening_mean"][-1]
+            assert len(mine) == 6 + 3 * (config.horizon + 1)
+    for m, t in thresholds.items():
+        assert [float(r["value"]) for r in rows
+                if r["metric"] == "drop_threshold" and r["material"] == m] == [t]
+    from PIL import Image
+
+    assert Image.open(os.path.join(out, "opening_vs_step.png")).size[0] > 600
+
+
+def test_quick_run_writes_every_output(tmp_path):
+    config = hce.quick_config()
+    log = []
+    results = hce.run(config, str(tmp_path), log=log.append)
+    _check_outputs(str(tmp_path), results, config)
+    assert any("steps/s" in line for line in log)
+    with open(tmp_path / "training_norm2tex.csv") as f:
+        records = list(csv.DictReader(f))
+    assert len(records) == config.total_steps // (config.num_envs * config.rollout_steps)
+    assert float(records[-1]["steps_per_s"]) > 0
+
+
+def test_the_same_seed_gives_the_same_json(tmp_path):
+    # A smaller run than --quick (one image policy, one material, no empty gripper), twice.
+    config = replace(hce.quick_config(), conditions=("norm2tex",), materials=("wood",),
+                     eval_empty=False, eval_episodes=2, eval_envs=2,
+                     threshold_openings=(0.615, 0.6175))
+    a = hce.run(config, str(tmp_path / "a"), log=lambda line: None)
+    b = hce.run(config, str(tmp_path / "b"), log=lambda line: None)
+    assert open(tmp_path / "a" / "results.json").read() == open(
+        tmp_path / "b" / "results.json").read()
+    assert a == b
+    # The comparison can fail: the run trained and evaluated (the quick run's test checks how).
+    assert a["policies"]["norm2tex"]["evaluation"]["wood"]["episodes"] == 2
+
+
+def test_the_encoders_take_both_images_and_the_opening():
+    obs = {"opening": torch.full((5, 1), 0.6),
+           "digit_left": torch.randn(5, 80, 60, 3) * 0.1,
+           "digit_right": torch.randn(5, 80, 60, 3) * 0.1}
+    for encoder in hce.ENCODERS:
+        policy = hce.make_policy("norm2tex", (80, 60, 3), encoder)
+        action, logprob, entropy, value = policy.get_action_and_value(obs)
+        assert action.shape == (5,) and value.shape == (5,)
+        # The right image changes the features (shared network, both images used).
+        changed = dict(obs, digit_right=obs["digit_right"] + 0.5)
+        assert not torch.allclose(policy.encoder(obs), policy.encoder(changed))
+    blind = hce.make_policy("blind", None)
+    changed = dict(obs, digit_left=obs["digit_left"] + 0.5)
+    assert torch.equal(blind.encoder(obs), blind.encoder(changed))
+    with pytest.raises(ValueError, match="encoder"):
+        hce.make_policy("norm2tex", (80, 60, 3), "vgg")
+
+
+def test_sb3_is_refused_clearly_when_missing(tmp_path):
+    try:
+        import stable_baselines3  # noqa: F401
+        pytest.skip("stable_baselines3 is installed")
+    except ImportError:
+        pass
+    with pytest.raises(RuntimeError, match="stable_baselines3"):
+        hce.run(replace(hce.quick_config(), algo="sb3"), str(tmp_path), log=lambda line: None)
