@@ -450,8 +450,9 @@ void GripperSim::moveFingers(double dt) {
 double GripperSim::compliantFingerPosition(double max_move) const {
   // Each finger is a spring of stiffness k in series with its gel: at rest it sits at
   // x = drive + F(x) / k, F the gel's force at finger position x. The gel is 4-15 times
-  // stiffer than a servo finger (its law's slope is 4 N/mm at first touch, 15 N/mm at 0.5 mm),
-  // so x <- drive + F / k per tick would overshoot by that factor and diverge. One Newton step
+  // stiffer than a 1 N/mm drive (its law's slope is 4 N/mm at first touch, 15 N/mm at 0.5 mm),
+  // so x <- drive + F / k per tick would overshoot by that factor: it diverges until the speed
+  // limit catches it, then rings there (0.2 N and 20 um on a held cube). One Newton step
   // of x - drive - F(x) / k = 0 per tick instead, with dF/dx = -k_gel the law's tangent at the
   // indentation that carries F (both gels are pressed deeper when the fingers close, the
   // object between them staying put): the residual shrinks every tick by the error in k_gel
