@@ -85,7 +85,9 @@ void bindSim(py::module& m) {
       .def_readwrite("min_gap_m", &GripperOptions::min_gap_m, "gel gap at opening 0, m")
       .def_readwrite("max_gap_m", &GripperOptions::max_gap_m, "gel gap at opening 1, m")
       .def_readwrite("max_force_n", &GripperOptions::max_force_n, "the fingers' force limit, N")
-      .def_readwrite("max_speed_m_s", &GripperOptions::max_speed_m_s, "finger speed, m/s");
+      .def_readwrite("max_speed_m_s", &GripperOptions::max_speed_m_s, "finger speed, m/s")
+      .def_readwrite("stiffness_n_per_m", &GripperOptions::stiffness_n_per_m,
+                     "each finger's drive in series with its gel, N/m (0: rigid)");
   py::class_<ObjectOptions>(m, "ObjectOptions", "scene yaml section object")
       .def_readwrite("name", &ObjectOptions::name)
       .def_readwrite("mesh", &ObjectOptions::mesh, "mesh file or primitive ('box:30x30x30')")

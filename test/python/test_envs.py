@@ -78,7 +78,9 @@ def test_opening_wide_drops_the_cube_with_reward_zero():
     env = HoldCubeEnv(noise=False)
     obs, info = env.reset(seed=5)
     assert 0.45 <= obs["opening"][0] <= 0.55
-    assert np.all(obs["force"] > 30.0)  # the grasp at full pressure (35 N limit)
+    # The start command squeezes through the compliant drive: 1.5-3.8 N for 0.55-0.45.
+    assert np.all((obs["force"] > 1.0) & (obs["force"] < 4.5))
+    assert info["finger_opening"] > obs["opening"][0] + 0.05  # the fingers sit back
     rewards = []
     for step in range(128):
         obs, reward, terminated, truncated, info = env.step(2)  # open by 0.005 each step
@@ -89,8 +91,9 @@ def test_opening_wide_drops_the_cube_with_reward_zero():
     assert reward == 0.0
     # Before the drop it was rewarded as the curve says for its opening.
     assert rewards[-2] == pytest.approx(hold_reward(obs["opening"][0] - 0.005), abs=1e-6)
-    # The cube drops past the measured hold threshold of the scene (0.615-0.6175).
-    assert 0.6 < obs["opening"][0] < 0.66
+    # The cube drops past wood's measured hold threshold (0.5725, docs/python.md); the command
+    # goes on opening 0.005 a frame while it slips and falls clear of the gels (~0.05).
+    assert 0.5725 < obs["opening"][0] < 0.64
     env.close()
 
 

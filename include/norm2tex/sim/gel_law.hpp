@@ -32,6 +32,9 @@ class GelLaw {
   /// force(d) / d [N/m]: the stiffness of a linear spring that gives the law's force at d
   /// (the first segment's slope at d <= 0).
   double secantStiffness(double d) const;
+  /// dF/dd [N/m] at indentation `d`: n * force(d) / d on the power-law segment holding d (the
+  /// first segment's slope at d <= 0). What a small extra indentation costs in force.
+  double tangentStiffness(double d) const;
 
   const std::vector<std::pair<double, double>>& points() const { return points_; }
 

@@ -77,7 +77,10 @@ struct ObjectCollision {
 ///
 /// Fingers are position-controlled at max_speed, coupled (both at the same distance from the
 /// centre plane), and stop closing once either gel carries max_force: the grip force then comes
-/// from the gel law, and a command narrower than the object indents both gels.
+/// from the gel law, and a command narrower than the object indents both gels. With
+/// gripper.stiffness_n_per_m = k > 0 the drive is compliant: each finger sits back from the
+/// commanded position by F / k (F the mean gel force), reached by one Newton step of the
+/// series equilibrium per tick (see compliantFingerPosition); k = 0 is rigid.
 ///
 /// Deterministic: the same config, reset seeds and commands give bit-identical trajectories.
 class GripperSim {
@@ -117,8 +120,8 @@ class GripperSim {
   /// nothing) for NaN or |delta| > 1.
   void addOpening(double delta);
   double commandedOpening() const { return command_; }
-  /// Where the fingers are now, as a normalised opening (may lag the command, or stop short of
-  /// it at the force limit).
+  /// Where the fingers are now, as a normalised opening (may lag the command, stop short of
+  /// it at the force limit, or sit wider than it on a compliant drive).
   double opening() const;
   /// Gap between the undeformed gel surfaces for a normalised opening, metres.
   double gapForOpening(double opening) const;
@@ -140,7 +143,8 @@ class GripperSim {
   static Eigen::Isometry3d gelInFinger(Finger finger);
   Eigen::Isometry3d gelInWorld(Finger finger) const;
   /// Prismatic joint position of a finger: distance of its undeformed gel surface from the
-  /// centre plane, metres (both fingers are equal: they are coupled).
+  /// centre plane, metres (both fingers are equal: they are coupled). Where the finger is, not
+  /// where it is commanded: a compliant drive leaves it further out.
   double fingerPosition() const { return finger_position_m_; }
   /// Latched once the object has left both gels and fallen below their lower edge; cleared
   /// by reset().
@@ -160,6 +164,11 @@ class GripperSim {
   void findHeightOffsetRange(const Eigen::Vector3d& centre);
   void buildWorld(double object_height_m);
   void moveFingers(double dt);
+  /// The finger position one step closer to the series equilibrium with the drive
+  /// (gripper.stiffness_n_per_m > 0), moving at most `max_move`.
+  double compliantFingerPosition(double max_move) const;
+  /// How far a finger sits back from its drive when its gel is indented `depth`, m (0: rigid).
+  double drivePreload(double depth) const;
   /// Calls visit(btManifoldPoint&) for every contact point between gel `gel_index` and the
   /// object (the gel is the manifold's body 0).
   template <typename Visit>
@@ -195,6 +204,9 @@ class GripperSim {
   std::array<GelContactState, 2> contacts_;
   double command_ = 1.0;
   double finger_position_m_ = 0.0;
+  /// Where the drive has brought the fingers (the command, speed- and force-limited); the
+  /// fingers sit back from it by the drive's deflection (gripper.stiffness_n_per_m).
+  double drive_position_m_ = 0.0;
   std::int64_t ticks_ = 0;
   std::uint32_t episode_ = 0;
   bool dropped_ = false;

@@ -17,6 +17,11 @@ struct GripperOptions {
   double max_gap_m = 0.040;
   double max_force_n = 35.0;    ///< force limit: the fingers stop closing at this gel force
   double max_speed_m_s = 0.02;  ///< finger speed (each finger), metres per second
+  /// Stiffness of each finger's drive (servo position loop, linkage, printed finger) in series
+  /// with its gel, N/m: a finger sits back from its commanded position by F / stiffness, F the
+  /// gel's normal force. 0: rigid position control (the fingers are where the command puts
+  /// them).
+  double stiffness_n_per_m = 0.0;
 };
 
 /// The object between the gels.

@@ -3,7 +3,8 @@ opening that does not let it fall.
 
 Episode: the simulator grasps the cube (seated at a random height 0-2.5 cm relative to the
 DIGITs' centres), then the command is set to a random value in [0.45, 0.55] -- narrower than the
-cube, so the fingers press with their full force -- and held for `grasp_frames` frames. The
+cube: through the scene's compliant drive (1 N/mm) the fingers press with 1.5-3.8 N, a grip that
+holds every material -- and held for `grasp_frames` frames. The
 policy then changes the opening by -0.005 / 0 / +0.005 per step. Reward per step: the paper's
 scaled sigmoid of the opening command (0 at 0.5, 1/2 at 0.6, 1 at 0.7: opening wider is a
 lighter grip), 0 and termination when the cube drops; truncated after 128 steps. A texture
@@ -85,12 +86,14 @@ class HoldCubeEnv(GripperEnv):
 def drop_threshold(material="wood", scene="hold_cube", openings=None, hold_frames=60,
                    height_offsets=(0.0, 0.0125, 0.025), **kwargs):
     """The largest opening command at which the cube is still held, found with the physics
-    alone (images are rendered but not used): for each opening (ascending), grasp at full
-    force as HoldCubeEnv does, command the opening, wait hold_frames frames; the threshold is
-    the last opening before the first that drops the cube at any of the height offsets.
-    Returns (threshold, {opening: dropped at any offset})."""
+    alone (images are rendered but not used): for each opening (ascending), grasp as
+    HoldCubeEnv does (from the lowest start command), command the opening, wait hold_frames
+    frames; the threshold is the last opening before the first that drops the cube at any of
+    the height offsets. The default openings run from the lowest start command (0.45) to 0.7
+    in steps of 0.0025 (half a discrete action). Returns (threshold, {opening: dropped at any
+    offset}); threshold None when the first opening drops already."""
     if openings is None:
-        openings = np.round(np.arange(0.55, 0.70001, 0.0025), 4)
+        openings = np.round(np.arange(START_OPENING[0], 0.70001, 0.0025), 4)
     env = HoldCubeVectorEnv(num_envs=len(height_offsets), material=material, variant=0,
                             scene=scene, noise=False, max_episode_steps=None, **kwargs)
     results = {}

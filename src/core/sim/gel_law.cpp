@@ -72,4 +72,9 @@ double GelLaw::secantStiffness(double d) const {
   return force(d) / d;
 }
 
+double GelLaw::tangentStiffness(double d) const {
+  if (!(d > 0.0)) return segments_.front().a;
+  return segmentForIndentation(d).n * force(d) / d;
+}
+
 }  // namespace norm2tex

@@ -144,12 +144,17 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   const EpisodeOptions& e = config_.episode;
   const double grip_depth =
       e.grasp_force_n > 0 ? config_.gel_law.indentation(e.grasp_force_n) : e.grasp_indentation_m;
-  if (e.grasp_opening < 0 && objectWidthM() - 2 * grip_depth < config_.gripper.min_gap_m) {
+  const double grip_reach = grip_depth + drivePreload(grip_depth);
+  if (e.grasp_opening < 0 && objectWidthM() - 2 * grip_reach < config_.gripper.min_gap_m) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
             << " mm wide along the grip axis: the closed gripper (gripper.min_gap_mm = "
             << config_.gripper.min_gap_m * 1e3 << ") cannot indent both gels "
             << grip_depth * 1e3 << " mm into it";
+    if (grip_reach > grip_depth) {
+      message << " (its drive would have to close " << (grip_reach - grip_depth) * 1e3
+              << " mm further on each side: gripper.stiffness_n_per_mm)";
+    }
     throw Error(message.str());
   }
   // Built once: resets rebuild the world but reuse the (stateless) shapes.
@@ -157,6 +162,7 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   findHeightOffsetRange(centre);
   command_ = 1.0;
   finger_position_m_ = config_.gripper.max_gap_m / 2.0;
+  drive_position_m_ = finger_position_m_;
   buildWorld(height_offset_range_.first);
 }
 
@@ -271,6 +277,11 @@ double GripperSim::objectMinHalfSizeM() const {
 
 double GripperSim::objectWidthM() const {
   return static_cast<double>(object_.mesh.bounds().sizes().y());
+}
+
+double GripperSim::drivePreload(double depth) const {
+  const double k = config_.gripper.stiffness_n_per_m;
+  return k > 0.0 ? config_.gel_law.force(depth) / k : 0.0;
 }
 
 double GripperSim::gapForOpening(double opening) const {
@@ -414,13 +425,17 @@ void GripperSim::buildWorld(double object_height_m) {
 }
 
 void GripperSim::moveFingers(double dt) {
-  // Coupled, speed-limited position control; the force limit stops closing (never opening).
+  // The drive: coupled, speed-limited position control; the force limit stops closing (never
+  // opening).
   const double target = gapForOpening(command_) / 2.0;
   const double max_move = config_.gripper.max_speed_m_s * dt;
-  double next = finger_position_m_ + std::clamp(target - finger_position_m_, -max_move, max_move);
+  double next = drive_position_m_ + std::clamp(target - drive_position_m_, -max_move, max_move);
   const double force = std::max(contacts_[0].normal_force_n, contacts_[1].normal_force_n);
-  if (next < finger_position_m_ && force >= config_.gripper.max_force_n) next = finger_position_m_;
-  finger_position_m_ = next;
+  if (next < drive_position_m_ && force >= config_.gripper.max_force_n) next = drive_position_m_;
+  drive_position_m_ = next;
+  finger_position_m_ = config_.gripper.stiffness_n_per_m > 0.0
+                           ? compliantFingerPosition(max_move)
+                           : drive_position_m_;
   for (int i = 0; i < 2; ++i) {
     // The gel box's centre sits half a thickness behind the gel surface (gel -z).
     const Eigen::Isometry3d box = gelInWorld(static_cast<Finger>(i)) *
@@ -430,6 +445,27 @@ void GripperSim::moveFingers(double dt) {
     gel.setWorldTransform(toBt(box));
     gel.setInterpolationWorldTransform(gel.getWorldTransform());
   }
+}
+
+double GripperSim::compliantFingerPosition(double max_move) const {
+  // Each finger is a spring of stiffness k in series with its gel: at rest it sits at
+  // x = drive + F(x) / k, F the gel's force at finger position x. The gel is 4-15 times
+  // stiffer than a 1 N/mm drive (its law's slope is 4 N/mm at first touch, 15 N/mm at 0.5 mm),
+  // so x <- drive + F / k per tick would overshoot by that factor: it diverges until the speed
+  // limit catches it, then rings there (0.2 N and 20 um on a held cube). One Newton step
+  // of x - drive - F(x) / k = 0 per tick instead, with dF/dx = -k_gel the law's tangent at the
+  // indentation that carries F (both gels are pressed deeper when the fingers close, the
+  // object between them staying put): the residual shrinks every tick by the error in k_gel
+  // alone, however stiff the gel. Out of contact k_gel = 0 and the finger is where the drive
+  // is. One drive moves both fingers (a servo through a rack or linkage), so both sit back by
+  // the mean of the two forces: at rest the object's balance along the grip axis makes them
+  // equal, in motion the mean is what the drive carries.
+  const double k = config_.gripper.stiffness_n_per_m;
+  const double force = 0.5 * (contacts_[0].normal_force_n + contacts_[1].normal_force_n);
+  const double k_gel =
+      force > 0.0 ? config_.gel_law.tangentStiffness(config_.gel_law.indentation(force)) : 0.0;
+  const double residual = drive_position_m_ + force / k - finger_position_m_;
+  return finger_position_m_ + std::clamp(residual * k / (k + k_gel), -max_move, max_move);
 }
 
 template <typename Visit>
@@ -610,7 +646,7 @@ double GripperSim::closeOnTheObject(double offset_m) {
     return std::clamp((gap - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0, 1.0);
   };
   const auto ticksToArrive = [&] {
-    const double travel = std::abs(finger_position_m_ - gapForOpening(command_) / 2.0);
+    const double travel = std::abs(drive_position_m_ - gapForOpening(command_) / 2.0);
     return static_cast<int>(std::ceil(travel / g.max_speed_m_s / tickSeconds()));
   };
   if (e.grasp_opening >= 0.0) {
@@ -641,7 +677,8 @@ double GripperSim::closeOnTheObject(double offset_m) {
       e.grasp_force_n > 0.0 ? config_.gel_law.indentation(e.grasp_force_n) : e.grasp_indentation_m;
   const double width = 2.0 * finger_position_m_ + contacts_[0].penetration_m +
                        contacts_[1].penetration_m;
-  command_ = openingForGap(width - 2.0 * depth);
+  // A compliant drive must go further by the deflection the grip's force causes.
+  command_ = openingForGap(width - 2.0 * (depth + drivePreload(depth)));
   step(ticksToArrive());
   return command_;
 }
@@ -680,6 +717,7 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
         (objectWidthM() + 2 * kSeatClearance - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0,
         1.0);
     finger_position_m_ = gapForOpening(command_) / 2.0;
+    drive_position_m_ = finger_position_m_;
     buildWorld(offset);
   };
   seat();

@@ -63,6 +63,12 @@ void validate(const GripperSimConfig& c) {
                    g.max_force_n, "(0, 500] N");
   requireParameter(g.max_speed_m_s > 0.0 && g.max_speed_m_s <= 1.0, "gripper.max_speed_mm_s",
                    g.max_speed_m_s * 1e3, "(0, 1000] mm/s");
+  // Stiffer than 1 MN/m the fingers' deflection is below a nanometre at the force limit: rigid
+  // control (0) says that exactly.
+  requireParameter(std::isfinite(g.stiffness_n_per_m) && g.stiffness_n_per_m >= 0.0 &&
+                       g.stiffness_n_per_m <= 1e6,
+                   "gripper.stiffness_n_per_mm", g.stiffness_n_per_m * 1e-3,
+                   "0 (rigid) or (0, 1000] N/mm");
   const ObjectOptions& o = c.object;
   requireParameter(!o.mesh.empty(), "object.mesh", "''", "a mesh file or box:XxYxZ / sphere:R");
   requireParameter(o.scale > 0.0 && o.scale <= 1000.0, "object.scale", o.scale, "(0, 1000]");
@@ -125,14 +131,18 @@ GripperSimConfig loadGripperSimConfig(const std::string& yaml_path) {
       requireKnownKeys(root, "", {"gripper", "object", "physics", "episode", "gel"});
     }
     const YAML::Node g = root["gripper"];
-    requireKnownKeys(
-        g, "gripper",
-        {"base_height_mm", "min_gap_mm", "max_gap_mm", "max_force_n", "max_speed_mm_s"});
+    requireKnownKeys(g, "gripper",
+                     {"base_height_mm", "min_gap_mm", "max_gap_mm", "max_force_n", "max_speed_mm_s",
+                      "stiffness_n_per_mm"});
     readMm(g, "base_height_mm", c.gripper.base_height_m);
     readMm(g, "min_gap_mm", c.gripper.min_gap_m);
     readMm(g, "max_gap_mm", c.gripper.max_gap_m);
     read(g, "max_force_n", c.gripper.max_force_n);
     readMm(g, "max_speed_mm_s", c.gripper.max_speed_m_s);
+    // N/mm in the file, N/m in the struct.
+    if (g && g["stiffness_n_per_mm"]) {
+      c.gripper.stiffness_n_per_m = g["stiffness_n_per_mm"].as<double>() * 1e3;
+    }
 
     const YAML::Node o = root["object"];
     requireKnownKeys(o, "object", {"name", "mesh", "scale", "mass_kg", "collision", "friction"});
