@@ -90,7 +90,7 @@ class ExperimentConfig:
     eval_empty: bool = True
     seed: int = 0                      # training; torch
     eval_seed: int = 1_000_000         # evaluation episodes: seeds eval_seed, eval_seed + 1, ...
-    # drop_threshold's openings (None: its default, 0.55-0.70 in steps of 0.0025).
+    # drop_threshold's openings (None: its default, 0.45-0.70 in steps of 0.0025).
     threshold_openings: tuple = None
     threads: int = 0                   # the simulator's C++ threads (0: every core)
     device: str = None                 # None: cuda if available, else cpu
@@ -99,11 +99,12 @@ class ExperimentConfig:
 
 def quick_config(**overrides):
     """A smoke run of under a minute: 3 updates of 3 environments x 16 steps per policy, 16-step
-    episodes, 3 evaluation episodes per material, thresholds searched from 0.60 up."""
+    episodes, 3 evaluation episodes per material, thresholds searched over 0.50-0.62 in steps of
+    0.005."""
     config = ExperimentConfig(
         total_steps=3 * 3 * 16, num_envs=3, rollout_steps=16, update_epochs=2, minibatches=2,
         horizon=16, eval_episodes=3, eval_envs=3,
-        threshold_openings=tuple(np.round(np.arange(0.60, 0.70001, 0.0025), 4)))
+        threshold_openings=tuple(np.round(np.arange(0.50, 0.62001, 0.005), 4)))
     return replace(config, **overrides)
 
 
