@@ -118,6 +118,16 @@ class ResNet18(nn.Module):
         return self.fc(x.mean(dim=(2, 3)))
 
 
+def use_deterministic_kernels():
+    """Deterministic kernels where this PyTorch can ask for them without failing on an op that
+    has none (torch.use_deterministic_algorithms(..., warn_only=True), 1.11 on; Debian 11's 1.7
+    has neither): on a CPU the ops used here are deterministic anyway, so older versions skip it."""
+    try:
+        torch.use_deterministic_algorithms(True, warn_only=True)
+    except (AttributeError, TypeError):
+        pass
+
+
 def build_model(arch, classes, downscale=4, channels=3):
     """The named architecture ("small" or "resnet18") for `classes` classes."""
     if arch == "small":
@@ -194,7 +204,7 @@ def run(export_dir, test_variants=(3,), epochs=12, seed=0, downscale=4, arch="sm
     if threads:
         torch.set_num_threads(threads)
     torch.manual_seed(seed)
-    torch.use_deterministic_algorithms(True, warn_only=True)
+    use_deterministic_kernels()
     if device == "cuda":
         torch.backends.cudnn.benchmark = False
     train, test, classes = split(export_dir, test_variants)
