@@ -98,11 +98,15 @@ ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
   pnh.param("window", p.window, p.window);
   if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
+  pnh.param<std::string>("trace_file", p.trace_file, "");
   return p;
 }
 
 ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : params_(readContactSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
+    : params_(readContactSimParams(private_nh)),
+      trace_(params_.trace_file, {"woke", "physics", "tf", "frame"}),
+      nh_(nh),
+      private_nh_(private_nh) {
   keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
   std::optional<MaterialConfig> material;
   if (!params_.material_config.empty()) material = loadMaterialConfig(params_.material_config);
@@ -456,9 +460,10 @@ void ContactSim::runClock() {
     when.tv_nsec = static_cast<long>(next % 1'000'000'000);
     if (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &when, nullptr) != 0) continue;  // EINTR
     if (stop_clock_) break;
+    const std::int64_t woke_ns = trace_.enabled() ? FrameTrace::now() : 0;
     ros::WallTime tick;
     tick.fromNSec(static_cast<std::uint64_t>(next));
-    onTick(tick);
+    onTick(tick, woke_ns);
     next += period;
     // Far behind (a stalled machine): onTick has let the missed frames go; so does the grid.
     const std::int64_t now = ros::WallTime::now().toNSec();
@@ -466,7 +471,7 @@ void ContactSim::runClock() {
   }
 }
 
-void ContactSim::onTick(const ros::WallTime& tick_time) {
+void ContactSim::onTick(const ros::WallTime& tick_time, std::int64_t woke_ns) {
   std::lock_guard<std::mutex> lock(mutex_);
   // Physics follows the wall clock: a late tick (a loaded machine) catches up by stepping the
   // frames that are due, at most a few at a time; further behind, it warns and lets them go.
@@ -487,7 +492,7 @@ void ContactSim::onTick(const ros::WallTime& tick_time) {
       anchor_frame_ + 1 + ((tick - wall_anchor_).toNSec() + kEarlyNs) / frame_period_ns_;
   int stepped = 0;
   while (frame_ < due && stepped < kMaxCatchUp) {
-    advanceFrame();
+    advanceFrame(woke_ns);
     ++stepped;
   }
   if (frame_ < due) {
@@ -498,7 +503,7 @@ void ContactSim::onTick(const ros::WallTime& tick_time) {
   }
 }
 
-void ContactSim::advanceFrame() {
+void ContactSim::advanceFrame(std::int64_t woke_ns) {
   sim_->step(ticks_per_frame_);
   ++frame_;
   if (anchor_to_wall_) {
@@ -507,7 +512,13 @@ void ContactSim::advanceFrame() {
     time_base_ = first - (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
     anchor_to_wall_ = false;
   }
+  if (trace_.enabled()) {
+    trace_.begin(frameStamp());
+    trace_.markAt(kTraceWoke, woke_ns);
+    trace_.mark(kTracePhysics);
+  }
   publishFrame();
+  trace_.end();
 }
 
 void ContactSim::waitForTfSubscribers() {
@@ -557,6 +568,7 @@ std::uint32_t ContactSim::publishFrame() {
   tf2_msgs::TFMessage tf;
   tf.transforms = std::move(transforms);
   tf_pub_.publish(tf);
+  trace_.mark(kTraceTf);
 
   publishStateChange(stamp);
 
@@ -596,7 +608,9 @@ std::uint32_t ContactSim::publishFrame() {
     frame.normal_force.push_back(sim_->contact(static_cast<Finger>(i)).normal_force_n);
   }
   // Lock-step: every renderer answers this frame before the next one is simulated.
-  return lock_step_->publish(frame_pub_, frame);
+  const std::uint32_t missing = lock_step_->publish(frame_pub_, frame);
+  trace_.mark(kTraceFrame);
+  return missing;
 }
 
 }  // namespace norm2tex

@@ -13,6 +13,7 @@
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include "frame_trace.hpp"
 #include "lock_step.hpp"
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/EpisodeState.h"
@@ -55,6 +56,9 @@ struct ContactSimParams {
   /// the renderers draw this one. Every ~step and ~reset still returns only once all of its
   /// frames are answered (1 = strict lock-step within a step too).
   int window = 2;
+  /// ~trace_file: real time, write when each frame's stages were reached to this CSV at
+  /// shutdown (scripts/ros_benchmark --trace); "" = none.
+  std::string trace_file;
 };
 
 /// Friction against the gels with ~material none and no ~friction (the scene default's).
@@ -82,7 +86,8 @@ class ContactSim {
   /// Real time: sleeps to each frame period's tick (absolute wall-clock time) and handles it on
   /// its own thread.
   void runClock();
-  void onTick(const ros::WallTime& tick);
+  /// `woke_ns`: when the clock thread woke for it (for the trace).
+  void onTick(const ros::WallTime& tick, std::int64_t woke_ns);
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
   bool applyCommand(const GripperCommand& command);
@@ -96,7 +101,7 @@ class ContactSim {
   /// Either gel holds the object deeper than the gel law's table reaches.
   bool tooDeep() const;
   /// Advances one sensor frame of physics and publishes it.
-  void advanceFrame();
+  void advanceFrame(std::int64_t woke_ns = 0);
   /// Before the first acknowledged frame: until every renderer listens on /tf (bounded).
   void waitForTfSubscribers();
   /// Publishes the current frame; in synchronous mode with ~renderers, waits for their answers.
@@ -105,6 +110,10 @@ class ContactSim {
   ros::Time frameStamp() const;
 
   ContactSimParams params_;
+  /// Real time, ~trace_file: the stages of each frame (the clock thread woke, its physics done,
+  /// its TF sent, its SimFrame sent).
+  enum TraceStage : std::size_t { kTraceWoke, kTracePhysics, kTraceTf, kTraceFrame };
+  FrameTrace trace_;
   std::unique_ptr<GripperSim> sim_;
   std::unique_ptr<ContactPatchMeter> meters_[2];
   int ticks_per_frame_ = 17;

@@ -7,11 +7,16 @@
 //                                             arrival here (wall-clock stamps), p50 / p99 / max;
 //                                             "split": also when its physics was done, and the
 //                                             first and second image
+//   norm2tex_ros_bench real_time FRAMES [split] --arrivals FILE
+//                                             also writes each frame's image arrivals as CSV
+//                                             (stamp_ns,first_ns,second_ns,first_frame_id), for
+//                                             scripts/latency_trace
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <string>
 #include <thread>
@@ -33,6 +38,7 @@ struct Arrivals {
   std::map<ros::Time, ros::WallTime> first;  // when the stamp's first image arrived
   std::map<ros::Time, ros::WallTime> last;   // when the stamp's last image arrived
   std::map<ros::Time, ros::WallTime> frame;  // when its SimFrame arrived (physics done)
+  std::map<ros::Time, std::string> first_from;  // the gel frame of the stamp's first image
   int total = 0;
 };
 
@@ -51,7 +57,7 @@ double percentile(std::vector<double> v, double p) {
 int main(int argc, char** argv) {
   const char* const usage =
       "usage: norm2tex_ros_bench synchronous [FRAMES >= 10]\n"
-      "       norm2tex_ros_bench real_time [FRAMES >= 10] [split]\n";
+      "       norm2tex_ros_bench real_time [FRAMES >= 10] [split] [--arrivals FILE]\n";
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
       std::fputs(usage, stdout);
@@ -59,12 +65,25 @@ int main(int argc, char** argv) {
     }
   }
   ros::init(argc, argv, "norm2tex_ros_bench", ros::init_options::AnonymousName);
-  const std::string mode = argc > 1 ? argv[1] : "";
+  // --arrivals FILE may stand anywhere; the rest is positional.
+  std::vector<std::string> args;
+  std::string arrivals_file;
+  bool bad = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--arrivals") != 0) {
+      args.emplace_back(argv[i]);
+    } else if (i + 1 < argc) {
+      arrivals_file = argv[++i];
+    } else {
+      bad = true;
+    }
+  }
+  const std::string mode = !args.empty() ? args[0] : "";
   // A malformed FRAMES counts as too few: the usage, not an uncaught exception.
-  const int frames = argc > 2 ? std::atoi(argv[2]) : 600;
-  const bool split = argc > 3 && std::string(argv[3]) == "split";
-  if ((mode != "synchronous" && mode != "real_time") || frames < 10 || (argc > 3 && !split) ||
-      argc > 4) {
+  const int frames = args.size() > 1 ? std::atoi(args[1].c_str()) : 600;
+  const bool split = args.size() > 2 && args[2] == "split";
+  if ((mode != "synchronous" && mode != "real_time") || frames < 10 || (args.size() > 2 && !split) ||
+      args.size() > 3 || bad || (!arrivals_file.empty() && mode != "real_time")) {
     std::fputs(usage, stderr);
     return 2;
   }
@@ -73,7 +92,10 @@ int main(int argc, char** argv) {
   auto on_image = [&](const sensor_msgs::Image::ConstPtr& m) {
     ++arrivals.total;
     const ros::WallTime now = ros::WallTime::now();
-    if (++arrivals.count[m->header.stamp] == 1) arrivals.first[m->header.stamp] = now;
+    if (++arrivals.count[m->header.stamp] == 1) {
+      arrivals.first[m->header.stamp] = now;
+      if (!arrivals_file.empty()) arrivals.first_from[m->header.stamp] = m->header.frame_id;
+    }
     arrivals.last[m->header.stamp] = now;
   };
   // Room for every image of a run: a benchmark that drops images at its own queue would
@@ -181,6 +203,16 @@ int main(int argc, char** argv) {
     if (f != arrivals.frame.end()) physics_ms.push_back(1e3 * (f->second.toSec() - stamp.toSec()));
   }
   if (latency_ms.size() < 10) return fail("fewer than 10 frames with both images");
+  if (!arrivals_file.empty()) {
+    std::ofstream out(arrivals_file);
+    out << "stamp_ns,first_ns,second_ns,first_frame_id\n";
+    for (const auto& [stamp, n] : arrivals.count) {
+      if (n != 2) continue;
+      out << stamp.toNSec() << ',' << arrivals.first[stamp].toNSec() << ','
+          << arrivals.last[stamp].toNSec() << ',' << arrivals.first_from[stamp] << '\n';
+    }
+    if (!out.flush()) return fail(("cannot write " + arrivals_file).c_str());
+  }
   std::printf(
       "real time, %zu frames: stamp -> both images here: p50 %.2f ms, p99 %.2f ms, "
       "max %.2f ms; %d frames with one image\n",

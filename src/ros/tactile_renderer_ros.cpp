@@ -80,6 +80,7 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
   pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
   pnh.param("texture_from_frame", p.texture_from_frame, p.texture_from_frame);
+  pnh.param<std::string>("trace_file", p.trace_file, "");
   if (p.texture_from_frame && p.material.empty()) {
     badParameter("texture_from_frame", "true",
                  "false with ~normal_map or ~atlas (frames name materials)");
@@ -89,6 +90,7 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
 
 TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readTactileRendererParams(private_nh)),
+      trace_(params_.trace_file, {"received", "pose", "rendered", "published"}),
       nh_(nh),
       tf_buffer_(ros::Duration(30.0)),
       // No thread of its own: the frames' thread inserts TF as it needs it (TransformWaiter).
@@ -233,6 +235,14 @@ bool TactileRendererRos::anyoneListens() const {
 }
 
 void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
+  if (trace_.enabled()) {
+    trace_.begin(frame->header.stamp);
+    trace_.mark(kTraceReceived);
+  }
+  struct EndTrace {
+    FrameTrace& trace;
+    ~EndTrace() { trace.end(); }
+  } end_trace{trace_};
   // Real time: skip the work when nobody listens (but keep the TF queue short). Synchronous:
   // every frame is rendered.
   if (!frame->acknowledge && !anyoneListens()) {
@@ -270,6 +280,7 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
     const Eigen::Isometry3d object_in_gel = ros_conversions::fromTransformMsg(
         tf_buffer_.lookupTransform(params_.gel_frame, params_.object_frame, frame->header.stamp)
             .transform);
+    trace_.mark(kTracePose);
     const std::int64_t noise_seed = params_.noise_seed < 0
                                         ? -1
                                         : static_cast<std::int64_t>(params_.noise_seed) * 1000003 +
@@ -281,12 +292,14 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
       if (frame->sensors[i] == params_.sensor_name) normal_force_n = frame->normal_force[i];
     }
     const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed, normal_force_n);
+    trace_.mark(kTraceRendered);
     std_msgs::Header header;
     header.stamp = frame->header.stamp;
     header.frame_id = params_.gel_frame;
     // The image always (one per frame); the others are built only for someone (a 300 kB depth
     // copy per frame is not free).
     image_pub_.publish(ros_conversions::toImageMsg(header, rendered.image));
+    trace_.mark(kTracePublished);
     if (info_pub_.getNumSubscribers() > 0) {
       info_pub_.publish(ros_conversions::toCameraInfo(header, renderer_->model()));
     }

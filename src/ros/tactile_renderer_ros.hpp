@@ -17,6 +17,7 @@
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/object_texture_cache.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
+#include "frame_trace.hpp"
 #include "transform_waiter.hpp"
 
 namespace norm2tex {
@@ -55,6 +56,9 @@ struct TactileRendererParams {
   /// ~texture_from_frame: render each frame with the material and variant its SimFrame names
   /// (probe datasets step through every variant); ~material and ~variant give the first one.
   bool texture_from_frame = false;
+  /// ~trace_file: write when each frame's stages were reached to this CSV at shutdown
+  /// (scripts/ros_benchmark --trace); "" = none.
+  std::string trace_file;
 };
 
 TactileRendererParams readTactileRendererParams(const ros::NodeHandle& private_nh);
@@ -82,6 +86,9 @@ class TactileRendererRos {
   TextureSource materialSource(const std::string& material, std::uint32_t variant) const;
 
   TactileRendererParams params_;
+  /// ~trace_file: each frame's stages (its SimFrame taken, its pose known, rendered, image sent).
+  enum TraceStage : std::size_t { kTraceReceived, kTracePose, kTraceRendered, kTracePublished };
+  FrameTrace trace_;
   std::unique_ptr<TactileRenderer> renderer_;
   std::shared_ptr<TexturedMesh> mesh_;
   std::string texture_key_;  ///< "material/variant" (or the file) being rendered

@@ -32,7 +32,7 @@ PROGRAMS = [
     "norm2tex_grasp_demo", "norm2tex_gripper_sweep", "norm2tex_make_demo_normal_map",
     "norm2tex_ros_bench", "norm2tex_wake_bench", "norm2tex_launch_check",
     "record_dataset", "free_port", "merge_dataset", "train_material_classifier", "texture_contrast",
-    "ros_benchmark", "env_benchmark", "hold_cube_experiment",
+    "ros_benchmark", "latency_trace", "env_benchmark", "hold_cube_experiment",
     "slurm/submit_dataset", "slurm/record_dataset.sbatch",
 ]
 

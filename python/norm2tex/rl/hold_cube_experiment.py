@@ -409,6 +409,55 @@ def evaluate(act, condition, material, config):
     )
 
 
+def material_spread(evaluation, materials):
+    """How differently a policy holds the materials: the range of its mean final openings over
+    `materials` (max - min) and a 95 % confidence interval of that difference, from the two
+    extreme materials' episode spreads (normal approximation: +- 1.96 sqrt(s1^2/n1 + s2^2/n2)).
+    Also each material's mean final opening with its own 95 % half-width. A policy that holds
+    every material alike has a range whose interval includes 0."""
+    means = {m: evaluation[m]["final_opening_mean"] for m in materials}
+    half = {m: 1.96 * evaluation[m]["final_opening_std"] / math.sqrt(evaluation[m]["episodes"])
+            for m in materials}
+    hi = max(materials, key=lambda m: means[m])
+    lo = min(materials, key=lambda m: means[m])
+    spread = means[hi] - means[lo]
+    h = 1.96 * math.sqrt(sum(evaluation[m]["final_opening_std"] ** 2 / evaluation[m]["episodes"]
+                             for m in (hi, lo)))
+    return {"range": spread, "ci95": [spread - h, spread + h], "widest": hi, "narrowest": lo,
+            "final_opening_ci95_half": half}
+
+
+def results_table(results):
+    """The README's table (markdown) of a results dict: per material its drop threshold and,
+    per policy, the mean final opening (+- its 95 % half-width), drop rate and mean return;
+    then each policy's range of final openings across the materials with its interval."""
+    policies = list(results["policies"])
+    materials = list(results["thresholds"])
+    head = "| material | drop threshold | " + " | ".join(
+        "%s: final opening, drop rate, return" % p for p in policies) + " |"
+    lines = [head, "|" + "---|" * (2 + len(policies))]
+    spreads = {p: material_spread(results["policies"][p]["evaluation"], materials)
+               for p in policies}
+    for m in materials + ([EMPTY] if all(EMPTY in results["policies"][p]["evaluation"]
+                                          for p in policies) else []):
+        t = results["thresholds"].get(m)
+        cells = []
+        for p in policies:
+            ev = results["policies"][p]["evaluation"][m]
+            half = 1.96 * ev["final_opening_std"] / math.sqrt(ev["episodes"])
+            cells.append("%.4f ± %.4f, %.0f %%, %.2f" % (
+                ev["final_opening_mean"], half, 100 * ev["drop_rate"], ev["return_mean"]))
+        lines.append("| %s | %s | %s |" % (m, "%.4f" % t if t is not None else "–",
+                                           " | ".join(cells)))
+    lines.append("| range across %s | %.4f | %s |" % (
+        ", ".join(materials),
+        max(results["thresholds"][m] for m in materials) -
+        min(results["thresholds"][m] for m in materials),
+        " | ".join("%.4f (95 %% CI %.4f to %.4f)" % (s["range"], *s["ci95"])
+                   for s in spreads.values())))
+    return "\n".join(lines)
+
+
 # --- outputs -----------------------------------------------------------------------------------
 
 def _finite_or_none(x):
@@ -653,6 +702,7 @@ def run(config=None, out_dir="hold_cube_experiment", log=print):
             log("%-11s on %-6s: final opening %.4f +- %.4f, drop rate %.2f, return %.2f" % (
                 condition, m, ev["final_opening_mean"], ev["final_opening_std"],
                 ev["drop_rate"], ev["return_mean"]))
+        entry["material_spread"] = material_spread(entry["evaluation"], config.materials)
         results["policies"][condition] = entry
 
     results = _clean(results)
