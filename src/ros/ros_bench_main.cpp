@@ -82,8 +82,9 @@ int main(int argc, char** argv) {
   // A malformed FRAMES counts as too few: the usage, not an uncaught exception.
   const int frames = args.size() > 1 ? std::atoi(args[1].c_str()) : 600;
   const bool split = args.size() > 2 && args[2] == "split";
-  if ((mode != "synchronous" && mode != "real_time") || frames < 10 || (args.size() > 2 && !split) ||
-      args.size() > 3 || bad || (!arrivals_file.empty() && mode != "real_time")) {
+  const bool bad_mode = mode != "synchronous" && mode != "real_time";
+  if (bad_mode || frames < 10 || (args.size() > 2 && !split) || args.size() > 3 || bad ||
+      (!arrivals_file.empty() && mode != "real_time")) {
     std::fputs(usage, stderr);
     return 2;
   }

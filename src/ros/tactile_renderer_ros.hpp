@@ -59,6 +59,9 @@ struct TactileRendererParams {
   /// ~trace_file: write when each frame's stages were reached to this CSV at shutdown
   /// (scripts/ros_benchmark --trace); "" = none.
   std::string trace_file;
+  /// ~cpu: the thread that renders the frames runs on this CPU only (real time: one CPU per
+  /// sensor keeps the two renders in parallel); -1: wherever the scheduler puts it.
+  int cpu = -1;
 };
 
 TactileRendererParams readTactileRendererParams(const ros::NodeHandle& private_nh);
@@ -100,6 +103,7 @@ class TactileRendererRos {
   bool prefetch_done_ = true;      ///< ... and whether it is being or has been prepared
   std::uint64_t rendered_ = 0, missed_ = 0;
   bool answered_any_ = false;
+  bool frame_thread_placed_ = false;  ///< ~cpu applied to the frame thread (its first frame)
   std::uint64_t last_answered_frame_ = 0;
   /// The latest answers by frame: repeated when a source offers one of these frames again.
   std::map<std::uint64_t, FrameRendered> recent_answers_;

@@ -133,6 +133,19 @@ def _check_outputs(out, results, config):
     for m, t in thresholds.items():
         assert [float(r["value"]) for r in rows
                 if r["metric"] == "drop_threshold" and r["material"] == m] == [t]
+        # The oracle opens up to the material's threshold and no further.
+        oracle = results["oracle"][m]
+        assert oracle["episodes"] == config.eval_episodes
+        assert max(oracle["opening_mean"][1:]) <= t + 1e-6, (m, t, oracle["opening_mean"])
+        assert [float(r["value"]) for r in rows if r["policy"] == "oracle" and
+                r["material"] == m and r["metric"] == "return_mean"] == [oracle["return_mean"]]
+    for p, entry in results["policies"].items():
+        spread = entry["material_spread"]
+        finals = [entry["evaluation"][m]["final_opening_mean"] for m in config.materials]
+        assert spread["range"] == max(finals) - min(finals)
+        assert spread["ci95"][0] <= spread["range"] <= spread["ci95"][1]
+    table = hce.results_table(results)
+    assert table.count("\n") == len(config.materials) + 2 + (1 if config.eval_empty else 0)
     from PIL import Image
 
     assert Image.open(os.path.join(out, "opening_vs_step.png")).size[0] > 600

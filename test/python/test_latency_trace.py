@@ -13,7 +13,7 @@ import importlib.util
 import os
 import signal
 import subprocess
-import tempfile
+import xmlrpc.client
 
 import pytest
 
@@ -147,7 +147,33 @@ def _tools_dir():
     return os.path.join(REPO, ".catkin_ws", "devel", "lib", "norm2tex")
 
 
+def _threads_cpus(pid):
+    """{thread id: the CPUs it may run on} of a process (/proc)."""
+    cpus = {}
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{tid}/status") as f:
+                for line in f:
+                    if line.startswith("Cpus_allowed_list:"):
+                        cpus[int(tid)] = line.split(":", 1)[1].strip()
+        except FileNotFoundError:  # a thread that ended meanwhile
+            pass
+    return cpus
+
+
+def _node_pid(master_uri, node):
+    master = xmlrpc.client.ServerProxy(master_uri)
+    code, message, uri = master.lookupNode("/latency_trace_test", node)
+    assert code == 1, message
+    code, message, pid = xmlrpc.client.ServerProxy(uri).getPid("/latency_trace_test")
+    assert code == 1, message
+    return pid
+
+
 def test_a_traced_real_time_launch_accounts_for_every_received_frame(tmp_path):
+    # With two or more CPUs, the renderers also run on CPUs of their own (left_cpu, right_cpu):
+    # their frame threads must be the manager's only threads held to one CPU each.
+    pinned = os.cpu_count() >= 2
     bench = os.path.join(_tools_dir(), "norm2tex_ros_bench")
     if not os.access(bench, os.X_OK):
         pytest.fail(f"{bench} not built (NORM2TEX_TOOLS_DIR)")
@@ -159,12 +185,17 @@ def test_a_traced_real_time_launch_accounts_for_every_received_frame(tmp_path):
     log = open(tmp_path / "roslaunch.log", "w+")
     launch = subprocess.Popen(
         ["roslaunch", "-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=real_time",
-         "manager:=true", f"trace_dir:={trace_dir}"],
+         "manager:=true", f"trace_dir:={trace_dir}"] +
+        (["left_cpu:=0", "right_cpu:=1"] if pinned else []),
         env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
     try:
         bench_run = subprocess.run(
             [bench, "real_time", "60", "--arrivals", str(trace_dir / "arrivals.csv")],
             env=env, capture_output=True, text=True, timeout=120)
+        if pinned and bench_run.returncode == 0:
+            cpus = _threads_cpus(_node_pid(env["ROS_MASTER_URI"], "/norm2tex_manager"))
+            held = sorted(c for c in cpus.values() if c in ("0", "1"))
+            assert held == ["0", "1"], cpus
     finally:
         if launch.poll() is None:
             os.killpg(launch.pid, signal.SIGINT)

@@ -421,6 +421,8 @@ TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
       {"_tf_timeout:=-1", "~tf_timeout"},
       {"_queue_size:=0", "~queue_size"},
       {"_opencv_threads:=0", "~opencv_threads"},
+      {"_cpu:=-2", "~cpu"},
+      {"_cpu:=100000", "~cpu"},  // more CPUs than any machine: named, not a silent no-op
   };
   for (const Case& c : cases) {
     std::string output;

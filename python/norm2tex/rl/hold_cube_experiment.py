@@ -19,16 +19,18 @@ applied to both, and its two feature vectors are concatenated with the opening. 
 enters every policy as (opening - 0.6) / 0.05.
 
 Budget (the default ExperimentConfig): 30 000 environment steps per policy (6 environments x
-128 steps per update, 39 updates). Measured on the project's 2-core VM while other jobs shared
-it (lower bounds): blind ~75 steps/s, textureless and norm2tex ~25 steps/s (every condition
-renders both sensors; the CNN's forward and backward passes make the difference), i.e. about
-7 + 20 + 20 minutes, under an hour for the three trainings; evaluation (3 policies x 4 x 50
-episodes of 128 steps, no gradients) adds roughly half an hour. quick_config(): a smoke run of
-under a minute that writes every output.
+128 steps per update, 39 updates). On the project's 2-core VM: blind 132-149 steps/s,
+textureless ~91-108, norm2tex ~78-82 (every condition renders both sensors; the CNN's forward
+and backward passes make the difference), about 26 minutes for the whole run with the
+evaluations (docs/python.md). quick_config(): a smoke run of under a minute that writes every
+output.
+
+Also measured per material: the oracle (threshold_oracle: open up to the material's threshold
+and stay), evaluated on the same episodes -- the return a policy that holds the cube earns.
 
 Outputs of run(config, out_dir) (also returned as a dict):
-  results.json            every number: config, thresholds, per policy its training log and
-                          per material (and "empty") its evaluation
+  results.json            every number: config, thresholds, oracle, per policy its training
+                          log, per material (and "empty") its evaluation and material_spread
   results.csv             the same numbers, one per row: policy, material, metric, step, value
   training_<policy>.csv   the training log (update, steps, steps_per_s, mean_return, ...)
   opening_vs_step.png     the paper's figure: opening vs step, a panel per policy, a curve per
@@ -409,6 +411,19 @@ def evaluate(act, condition, material, config):
     )
 
 
+def threshold_oracle(threshold):
+    """The reference a policy is measured against: knowing the material's drop threshold, open
+    while the next step stays at or below it, close when above it (an episode may start there),
+    else stay. Acts on a batch of observations, as a trained policy's act does."""
+    step = 0.005
+
+    def act(obs):
+        opening = np.asarray(obs["opening"], dtype=np.float64)[:, 0]
+        return np.where(opening + step <= threshold + 1e-6, 2,
+                        np.where(opening > threshold + 1e-6, 0, 1))
+    return act
+
+
 def material_spread(evaluation, materials):
     """How differently a policy holds the materials: the range of its mean final openings over
     `materials` (max - min) and a 95 % confidence interval of that difference, from the two
@@ -428,14 +443,19 @@ def material_spread(evaluation, materials):
 
 
 def results_table(results):
-    """The README's table (markdown) of a results dict: per material its drop threshold and,
-    per policy, the mean final opening (+- its 95 % half-width), drop rate and mean return;
-    then each policy's range of final openings across the materials with its interval."""
-    policies = list(results["policies"])
-    materials = list(results["thresholds"])
-    head = "| material | drop threshold | " + " | ".join(
+    """The README's table (markdown) of a results dict: per material its drop threshold, what
+    holding it at the threshold earns (the oracle's return) and, per policy, the mean final
+    opening (+- its 95 % half-width), drop rate and mean return; then each policy's range of
+    final openings across the materials with its interval."""
+    config = results.get("config", {})
+    policies = [p for p in config.get("conditions", results["policies"])
+                if p in results["policies"]]
+    materials = [m for m in config.get("materials", results["thresholds"])
+                 if m in results["thresholds"]]
+    oracle = results.get("oracle", {})
+    head = "| material | drop threshold | oracle's return | " + " | ".join(
         "%s: final opening, drop rate, return" % p for p in policies) + " |"
-    lines = [head, "|" + "---|" * (2 + len(policies))]
+    lines = [head, "|" + "---|" * (3 + len(policies))]
     spreads = {p: material_spread(results["policies"][p]["evaluation"], materials)
                for p in policies}
     for m in materials + ([EMPTY] if all(EMPTY in results["policies"][p]["evaluation"]
@@ -447,9 +467,10 @@ def results_table(results):
             half = 1.96 * ev["final_opening_std"] / math.sqrt(ev["episodes"])
             cells.append("%.4f ± %.4f, %.0f %%, %.2f" % (
                 ev["final_opening_mean"], half, 100 * ev["drop_rate"], ev["return_mean"]))
-        lines.append("| %s | %s | %s |" % (m, "%.4f" % t if t is not None else "–",
-                                           " | ".join(cells)))
-    lines.append("| range across %s | %.4f | %s |" % (
+        lines.append("| %s | %s | %s | %s |" % (
+            m, "%.4f" % t if t is not None else "–",
+            "%.2f" % oracle[m]["return_mean"] if m in oracle else "–", " | ".join(cells)))
+    lines.append("| range across %s | %.4f | | %s |" % (
         ", ".join(materials),
         max(results["thresholds"][m] for m in materials) -
         min(results["thresholds"][m] for m in materials),
@@ -496,12 +517,15 @@ def write_results_csv(path, results):
         w.writerow(("policy", "material", "metric", "step", "value"))
         for m, t in results["thresholds"].items():
             w.writerow(("", m, "drop_threshold", "", "" if t is None else repr(t)))
+        evaluations = [("oracle", results.get("oracle", {}))] + [
+            (p, entry["evaluation"]) for p, entry in results["policies"].items()]
         for p, entry in results["policies"].items():
             for r in entry["training"]:
                 for k in ("mean_return", "mean_length"):
                     v = r.get(k)
                     w.writerow((p, "", "train_" + k, r["steps"], "" if v is None else repr(v)))
-            for m, ev in entry["evaluation"].items():
+        for p, evaluation in evaluations:
+            for m, ev in evaluation.items():
                 for k, v in ev.items():
                     if isinstance(v, list):
                         for s, x in enumerate(v):
@@ -682,6 +706,17 @@ def run(config=None, out_dir="hold_cube_experiment", log=print):
         threshold, _ = drop_threshold(m, threads=config.threads, **kwargs)
         results["thresholds"][m] = threshold
         log("drop threshold %s: %s" % (m, threshold))
+
+    # What holding each material at its threshold earns on the same episodes: the ceiling a
+    # policy's return is read against.
+    results["oracle"] = {}
+    for m in config.materials:
+        if results["thresholds"][m] is None:
+            continue
+        ev = evaluate(threshold_oracle(results["thresholds"][m]), "blind", m, config)
+        results["oracle"][m] = ev
+        log("oracle      on %-6s: final opening %.4f, drop rate %.2f, return %.2f" % (
+            m, ev["final_opening_mean"], ev["drop_rate"], ev["return_mean"]))
 
     trainer = train_condition if config.algo == "ppo" else train_condition_sb3
     for condition in config.conditions:
