@@ -35,6 +35,7 @@ _CORE_NAMES = (
     "material_texture",
     "RenderedFrame",
     "read_image",
+    "block_mean",
     "calibrate_sensor",
     "TactileRenderer",
     "GripperOptions",

@@ -16,6 +16,7 @@
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/materials/procedural_material.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/render/block_mean.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
 #include "norm2tex/texture/height_atlas_baker.hpp"
@@ -272,6 +273,60 @@ void bindRender(py::module& m) {
       py::arg("path"),
       "Reads an image file as the package's tools do (OpenCV's decoders): (rows, cols, 3) uint8 "
       "bgr. Raises norm2tex.Error naming the file.");
+
+  m.def(
+      "block_mean",
+      [](const py::array& images, int factor, const py::object& background) {
+        // Views of the caller's arrays (no copy in): this runs on every environment step.
+        using Bytes = py::array_t<std::uint8_t, py::array::c_style>;
+        const Bytes in = Bytes::ensure(images);
+        if (!in || !images.dtype().is(py::dtype::of<std::uint8_t>()) ||
+            (in.ndim() != 3 && in.ndim() != 4) || in.shape(in.ndim() - 1) != 3) {
+          throw py::value_error("block_mean: images must be uint8 of shape (rows, cols, 3) or "
+                                "(N, rows, cols, 3)");
+        }
+        const bool batched = in.ndim() == 4;
+        const Py_ssize_t n = batched ? in.shape(0) : 1;
+        const int rows = static_cast<int>(in.shape(batched ? 1 : 0));
+        const int cols = static_cast<int>(in.shape(batched ? 2 : 1));
+        Bytes bg;
+        cv::Mat3b bg_view;
+        if (!background.is_none()) {
+          bg = Bytes::ensure(background);
+          if (!bg || !py::array(background).dtype().is(py::dtype::of<std::uint8_t>()) ||
+              bg.ndim() != 3 || bg.shape(0) != rows || bg.shape(1) != cols || bg.shape(2) != 3) {
+            throw py::value_error("block_mean: background must be uint8 of shape (rows, cols, 3), "
+                                  "the images' rows and cols");
+          }
+          bg_view = cv::Mat3b(rows, cols, const_cast<cv::Vec3b*>(
+                                              reinterpret_cast<const cv::Vec3b*>(bg.data())));
+        }
+        if (factor < 1 || factor > rows || factor > cols) {
+          throw py::value_error("block_mean: factor " + std::to_string(factor) +
+                                "; valid: 1 .. the smaller of rows and cols");
+        }
+        std::vector<Py_ssize_t> shape = {rows / factor, cols / factor, 3};
+        if (batched) shape.insert(shape.begin(), n);
+        py::array_t<float> out(shape);
+        const std::size_t in_step = static_cast<std::size_t>(rows) * cols;
+        const std::size_t out_step = static_cast<std::size_t>(rows / factor) * (cols / factor);
+        const auto* src = reinterpret_cast<const cv::Vec3b*>(in.data());
+        auto* dst = reinterpret_cast<cv::Vec3f*>(out.mutable_data());
+        {
+          py::gil_scoped_release release;
+          for (Py_ssize_t i = 0; i < n; ++i) {
+            const cv::Mat3b image(rows, cols, const_cast<cv::Vec3b*>(src + i * in_step));
+            cv::Mat3f block(rows / factor, cols / factor, dst + i * out_step);
+            blockMean(image, factor, bg_view, block);  // writes in place: the size matches
+          }
+        }
+        return out;
+      },
+      py::arg("images"), py::arg("factor"), py::arg("background") = py::none(),
+      "float32 mean of every factor x factor block of bgr8 images ((rows, cols, 3) or (N, rows, "
+      "cols, 3)), minus the background's when given; rows and cols past the last whole block are "
+      "dropped. Equals numpy's blocks.mean(axis=(2, 4), dtype=float32) of the same crop, ~20x "
+      "faster: what the environments' downscale and diff images are made with.");
 
   m.def(
       "calibrate_sensor",

@@ -239,3 +239,36 @@ def test_conformity_from_python_follows_the_force(sensor, cube):
                                   off.render(pose, normal_force_n=20.0).image)
     with pytest.raises(norm2tex.Error, match="force"):
         off.render(pose, normal_force_n=-1.0)
+
+
+def numpy_block_mean(images, factor, background=None):
+    """The reshape-mean the environments used before norm2tex.block_mean (the reference)."""
+    x = images if background is None else (
+        images.astype(np.int16) - background.astype(np.int16)[None])
+    n, rows, cols = x.shape[:3]
+    rows, cols = rows // factor * factor, cols // factor * factor
+    blocks = x[:, :rows, :cols].reshape((n, rows // factor, factor, cols // factor, factor, 3))
+    return blocks.mean(axis=(2, 4), dtype=np.float32)
+
+
+def test_block_mean_equals_numpy_bit_for_bit_and_refuses_bad_input():
+    rng = np.random.default_rng(3)
+    images = rng.integers(0, 256, size=(3, 61, 47, 3), dtype=np.uint8)
+    background = rng.integers(0, 256, size=(61, 47, 3), dtype=np.uint8)
+    for factor in (1, 2, 3, 4, 5):
+        for bg in (None, background):
+            expected = numpy_block_mean(images, factor, bg)
+            got = norm2tex.block_mean(images, factor, bg)
+            assert got.dtype == np.float32 and got.shape == expected.shape
+            assert np.array_equal(got, expected), (factor, bg is None)
+            # One image: the batch's first, without the batch axis.
+            assert np.array_equal(norm2tex.block_mean(images[0], factor, bg), expected[0])
+    # A non-contiguous batch (every other image) is read correctly too.
+    assert np.array_equal(norm2tex.block_mean(images[::2], 4), numpy_block_mean(images[::2], 4))
+    for bad in (dict(images=images.astype(np.int16), factor=2),
+                dict(images=images[..., :2], factor=2),
+                dict(images=images, factor=0),
+                dict(images=images, factor=48),
+                dict(images=images, factor=2, background=background[:60])):
+        with pytest.raises(ValueError):
+            norm2tex.block_mean(**bad)
