@@ -72,7 +72,7 @@ FEATURES = 64
 class ExperimentConfig:
     """Everything a run depends on (all of it is written to results.json)."""
 
-    total_steps: int = 30_000          # environment steps per policy
+    total_steps: int = 150_000         # environment steps per policy
     num_envs: int = 6                  # training environments (materials[i % len(materials)])
     rollout_steps: int = 128           # per environment and update
     update_epochs: int = 4
