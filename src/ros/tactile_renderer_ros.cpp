@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <optional>
@@ -92,6 +93,10 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
     badParameter("cpu", std::to_string(p.cpu),
                  "-1 (any CPU) or a CPU of this machine, 0 to " + std::to_string(cpus - 1));
   }
+  pnh.param("rehearse_ms", p.rehearse_ms, p.rehearse_ms);
+  if (!(p.rehearse_ms >= 0.0 && p.rehearse_ms <= 100.0)) {
+    badParameter("rehearse_ms", std::to_string(p.rehearse_ms), "0 (off) to 100 ms");
+  }
   if (p.texture_from_frame && p.material.empty()) {
     badParameter("texture_from_frame", "true",
                  "false with ~normal_map or ~atlas (frames name materials)");
@@ -161,6 +166,14 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   frame_nh.setCallbackQueue(&frame_queue_);
   frame_sub_ = frame_nh.subscribe(params_.frame_topic, 100, &TactileRendererRos::onFrame, this,
                                   ros::TransportHints().tcpNoDelay());
+  if (params_.rehearse_ms > 0.0) {
+    // Started (and stopped) here: roscpp starts its one wall-timer thread for the process when
+    // a timer is first started, and that thread would inherit the frames' thread's ~cpu.
+    rehearsal_timer_ = frame_nh.createWallTimer(ros::WallDuration(3600.0),
+                                                &TactileRendererRos::rehearse, this,
+                                                /*oneshot=*/true, /*autostart=*/true);
+    rehearsal_timer_.stop();
+  }
   frame_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &frame_queue_);
   frame_spinner_->start();
   // Latched: contact_sim, whenever it subscribes, learns that this renderer is ready.
@@ -178,6 +191,13 @@ TactileRendererRos::~TactileRendererRos() {
   frame_queue_.disable();
   tf_queue_.disable();
   frame_spinner_.reset();
+  if (params_.rehearse_ms > 0.0) {
+    // On stdout itself: by now ros::shutdown() has shut rosconsole down.
+    std::printf("[ INFO] %s: %lu frames rendered, %lu rehearsed %.1f ms before the next\n",
+                params_.sensor_name.c_str(), static_cast<unsigned long>(rendered_),
+                static_cast<unsigned long>(rehearsals_), params_.rehearse_ms);
+    std::fflush(stdout);
+  }
 }
 
 void TactileRendererRos::useTexture(const TextureSource& source, const std::string& key) {
@@ -246,6 +266,8 @@ bool TactileRendererRos::anyoneListens() const {
 }
 
 void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
+  const ros::WallTime received = ros::WallTime::now();
+  ++last_frame_.count;
   if (!frame_thread_placed_) {
     // ~cpu: the two sensors' frame threads wake for the same SimFrame microseconds apart. Left
     // to the scheduler, the second was often woken onto the CPU where the first had started,
@@ -321,6 +343,11 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
     }
     const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed, normal_force_n);
     trace_.mark(kTraceRendered);
+    if (params_.rehearse_ms > 0.0 && !frame->acknowledge) {
+      last_frame_.object_in_gel = object_in_gel;
+      last_frame_.noise_seed = noise_seed;
+      last_frame_.normal_force_n = normal_force_n;
+    }
     std_msgs::Header header;
     header.stamp = frame->header.stamp;
     header.frame_id = params_.gel_frame;
@@ -348,12 +375,49 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
                       static_cast<unsigned long>(missed_),
                       static_cast<unsigned long>(missed_ + rendered_), e.what());
   }
+  if (params_.rehearse_ms > 0.0 && !frame->acknowledge && answer.published) {
+    scheduleRehearsal(frame->header.stamp, received);
+  }
   if (frame->acknowledge) {
     rendered_pub_.publish(answer);
     recent_answers_[answer.frame] = answer;
     if (recent_answers_.size() > 256) recent_answers_.erase(recent_answers_.begin());
     last_answered_frame_ = answer.frame;
     answered_any_ = true;
+  }
+}
+
+void TactileRendererRos::scheduleRehearsal(const ros::Time& stamp, const ros::WallTime& received) {
+  // The next frame is due one period after this one arrived; the period is the stamps' step
+  // (real time: simulated and wall time advance together). Not known before the second frame.
+  const ros::Time previous = last_frame_.stamp;
+  last_frame_.stamp = stamp;
+  last_frame_.received = received;
+  if (previous.isZero() || stamp <= previous) return;
+  const double period_s = (stamp - previous).toSec();
+  if (period_s > 1.0) return;  // a pause, not a rate
+  const double delay_s =
+      (received - ros::WallTime::now()).toSec() + period_s - params_.rehearse_ms * 1e-3;
+  if (delay_s <= 0.0) return;  // the frame ran late: the next one is too close to rehearse
+  rehearsal_of_ = last_frame_.count;
+  rehearsal_timer_.stop();
+  rehearsal_timer_.setPeriod(ros::WallDuration(delay_s));
+  rehearsal_timer_.start();
+}
+
+void TactileRendererRos::rehearse(const ros::WallTimerEvent&) {
+  // On the frames' thread: no frame can be rendering now. A newer frame than the one armed for
+  // means the rehearsal came too late to matter.
+  if (rehearsal_of_ != last_frame_.count) return;
+  try {
+    renderer_->render(last_frame_.object_in_gel, last_frame_.noise_seed,
+                      last_frame_.normal_force_n);
+    if (rehearsals_++ == 0) {
+      ROS_INFO("%s: rehearsing each real-time frame %.1f ms before the next one is due",
+               params_.sensor_name.c_str(), params_.rehearse_ms);
+    }
+  } catch (const Error& e) {
+    ROS_DEBUG("%s: rehearsal skipped: %s", params_.sensor_name.c_str(), e.what());
   }
 }
 

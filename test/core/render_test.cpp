@@ -219,6 +219,25 @@ TEST_F(RenderTest, SamePoseSameImage) {
   EXPECT_GT(cv::norm(a, c, cv::NORM_INF), 0.0) << "noise on vs off differ";
 }
 
+// A frame's render owes nothing to the renders before it: tactile_renderer's ~rehearse_ms
+// renders the last frame again between frames and relies on it. Textured, with the gel's
+// conformity (the default sensor) and noise; the frame rendered after a wider press (whose
+// overlay box and conformity buffers are larger) equals the frame rendered first.
+TEST_F(RenderTest, ARenderDoesNotDependOnThePreviousOnes) {
+  ASSERT_TRUE(model_.conformity.enabled) << "the default sensor conforms to the texture";
+  renderer_.setObject(sphere(), randomAtlas(), 0.2);
+  TactileRenderer fresh(model_);
+  fresh.setObject(sphere(), randomAtlas(), 0.2);
+  const Eigen::Isometry3d pose = pressedSphere(-1, 1, 0.7);
+  renderer_.render(pressedSphere(2, -1, 1.5), 5, 4.0);
+  renderer_.render(pressedSphere(2, -1, 1.5), 5, 4.0);  // a rehearsal of the same frame
+  const TactileFrame& after = renderer_.render(pose, 7, 2.0);
+  const TactileFrame& first = fresh.render(pose, 7, 2.0);
+  EXPECT_EQ(cv::norm(after.image, first.image, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(after.gel_mm, first.gel_mm, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(after.contact_mask, first.contact_mask, cv::NORM_INF), 0.0);
+}
+
 TEST_F(RenderTest, DepthIsTheGelDeformationInMetres) {
   renderer_.setObject(sphere());
   const TactileFrame& frame = renderer_.render(pressedSphere(0, 0, 1.2), -1);

@@ -14,7 +14,6 @@ Usage: test_install_space.py REPO_ROOT CATKIN_BUILD_DIR
 import os
 import re
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -23,6 +22,8 @@ import unittest
 
 REPO = os.path.abspath(sys.argv[1])
 BUILD = os.path.abspath(sys.argv[2])
+sys.path.insert(0, os.path.join(REPO, "test", "python"))
+import ros_launch  # noqa: E402  (the tests' roslaunch stop, from the source tree's test folder)
 
 # The programs README names, as `rosrun norm2tex NAME`.
 PROGRAMS = [
@@ -153,12 +154,7 @@ class InstallSpace(unittest.TestCase):
                 self.assertRegex(echo.stdout, r"width: 240\b")
                 self.assertRegex(echo.stdout, r"encoding: \"?bgr8")
         finally:
-            os.killpg(launch.pid, signal.SIGINT)
-            try:
-                launch.communicate(timeout=30)
-            except subprocess.TimeoutExpired:
-                os.killpg(launch.pid, signal.SIGKILL)
-                launch.communicate()
+            ros_launch.stop(launch)
 
     def test_record_dataset_records_a_complete_dataset(self):
         out = os.path.join(self.dir, "dataset")

@@ -11,11 +11,13 @@ import csv
 import importlib.machinery
 import importlib.util
 import os
-import signal
+import re
 import subprocess
 import xmlrpc.client
 
 import pytest
+
+import ros_launch
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCRIPT = os.path.join(REPO, "scripts", "latency_trace")
@@ -134,12 +136,6 @@ def test_missing_or_short_traces_are_clear_errors(tmp_path, capsys):
     assert "no column pose_ns" in capsys.readouterr().err
 
 
-def _free_port():
-    out = subprocess.run([os.path.join(REPO, "scripts", "free_port")], capture_output=True,
-                         text=True, check=True).stdout
-    return int(out)
-
-
 def _tools_dir():
     tools = os.environ.get("NORM2TEX_TOOLS_DIR")
     if tools:
@@ -179,15 +175,17 @@ def test_a_traced_real_time_launch_accounts_for_every_received_frame(tmp_path):
         pytest.fail(f"{bench} not built (NORM2TEX_TOOLS_DIR)")
     trace_dir = tmp_path / "trace"
     trace_dir.mkdir()
-    port = _free_port()
+    port = ros_launch.free_port()
     env = dict(os.environ, ROS_MASTER_URI=f"http://localhost:{port}", ROS_HOSTNAME="localhost",
                ROS_HOME=str(tmp_path / "ros_home"))
     log = open(tmp_path / "roslaunch.log", "w+")
-    launch = subprocess.Popen(
-        ["roslaunch", "-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=real_time",
-         "manager:=true", f"trace_dir:={trace_dir}"] +
+    # rehearse_ms: each renderer renders its last frame again between frames; no frame may be
+    # lost or reordered for it.
+    launch = ros_launch.start(
+        ["-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=real_time", "manager:=true",
+         f"trace_dir:={trace_dir}", "rehearse_ms:=5"] +
         (["left_cpu:=0", "right_cpu:=1"] if pinned else []),
-        env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        env, log)
     try:
         bench_run = subprocess.run(
             [bench, "real_time", "60", "--arrivals", str(trace_dir / "arrivals.csv")],
@@ -197,13 +195,7 @@ def test_a_traced_real_time_launch_accounts_for_every_received_frame(tmp_path):
             held = sorted(c for c in cpus.values() if c in ("0", "1"))
             assert held == ["0", "1"], cpus
     finally:
-        if launch.poll() is None:
-            os.killpg(launch.pid, signal.SIGINT)
-            try:
-                launch.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                os.killpg(launch.pid, signal.SIGKILL)
-                launch.wait()
+        ros_launch.stop(launch)
         log.seek(0)
         launch_log = log.read()
         log.close()
@@ -240,6 +232,14 @@ def test_a_traced_real_time_launch_accounts_for_every_received_frame(tmp_path):
     # The table's whole is what the subscriber measured (its own p50 line).
     bench_p50 = float(bench_run.stdout.split("p50 ")[1].split(" ms")[0])
     assert stages["stamp -> both images"]["p50_ms"] == pytest.approx(bench_p50, abs=0.01)
+    # Each renderer rehearsed between frames (the shutdown line), at most once per frame: a
+    # rehearsal is skipped only after the first frame or when a frame ran late.
+    for sensor in latency_trace.SENSORS:
+        assert f"{sensor}: rehearsing each real-time frame 5.0 ms" in launch_log, launch_log
+        found = re.search(sensor + r": (\d+) frames rendered, (\d+) rehearsed 5.0 ms", launch_log)
+        assert found, launch_log
+        rendered, rehearsed = int(found.group(1)), int(found.group(2))
+        assert rendered >= len(arrivals) and rendered // 2 <= rehearsed <= rendered, found.group(0)
     # Rendering is real work: on every frame, each sensor's render takes time.
     for sensor in latency_trace.SENSORS:
         assert stages[f"{sensor}: pose -> rendered"]["p50_ms"] > 0.1

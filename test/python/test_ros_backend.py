@@ -7,15 +7,14 @@ Starts its own master on a free port (scripts/free_port). Run (with the workspac
     /usr/bin/python3 -m pytest -q test/python/test_ros_backend.py
 """
 import os
-import signal
-import subprocess
 import tempfile
 import time
 
 import numpy as np
 import pytest
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import ros_launch
+
 LAUNCH_SEED = 3  # the launch's seed:=, the in-process backend's seed
 
 # Pixels could differ where the ROS renderer's pose went through TF (the object's pose in the gel
@@ -24,12 +23,6 @@ LAUNCH_SEED = 3  # the launch's seed:=, the in-process backend's seed
 # pixel differs, so the images must be equal bit for bit (and the depths, and the states exactly).
 MAX_DIFFERING_PIXEL_FRACTION = 0.0
 MAX_PIXEL_DIFFERENCE = 0
-
-
-def _free_port():
-    out = subprocess.run([os.path.join(REPO, "scripts", "free_port")], capture_output=True,
-                         text=True, check=True).stdout
-    return int(out)
 
 
 @pytest.fixture(scope="module")
@@ -49,27 +42,20 @@ def sensor_yaml():
 def ros_system(sensor_yaml):
     """gripper_sim.launch mode:=synchronous on a master of its own; this process's rospy on it."""
     home = tempfile.mkdtemp(prefix="norm2tex_ros_backend_test_")
-    port = _free_port()
+    port = ros_launch.free_port()
     uri = "http://localhost:%d" % port
     env = dict(os.environ, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost",
                ROS_HOME=os.path.join(home, "ros_home"))
     log = open(os.path.join(home, "roslaunch.log"), "w+")
-    launch = subprocess.Popen(
-        ["roslaunch", "-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=synchronous",
-         "noise_seed:=-1", "texture_from_frame:=true", "seed:=%d" % LAUNCH_SEED,
-         "sensor:=" + sensor_yaml],
-        env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+    launch = ros_launch.start(
+        ["-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=synchronous", "noise_seed:=-1",
+         "texture_from_frame:=true", "seed:=%d" % LAUNCH_SEED, "sensor:=" + sensor_yaml],
+        env, log)
     os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
     try:
         yield launch, log
     finally:
-        if launch.poll() is None:
-            os.killpg(launch.pid, signal.SIGINT)
-            try:
-                launch.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                os.killpg(launch.pid, signal.SIGKILL)
-                launch.wait()
+        ros_launch.stop(launch, timeout_s=20)
         log.close()
 
 

@@ -423,6 +423,9 @@ TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
       {"_opencv_threads:=0", "~opencv_threads"},
       {"_cpu:=-2", "~cpu"},
       {"_cpu:=100000", "~cpu"},  // more CPUs than any machine: named, not a silent no-op
+      {"_rehearse_ms:=-1", "~rehearse_ms"},
+      {"_rehearse_ms:=.nan", "~rehearse_ms"},
+      {"_rehearse_ms:=1000", "~rehearse_ms"},
   };
   for (const Case& c : cases) {
     std::string output;

@@ -18,12 +18,12 @@ The images are background-subtracted (image="diff_float") and averaged down `dow
 applied to both, and its two feature vectors are concatenated with the opening. The opening
 enters every policy as (opening - 0.6) / 0.05.
 
-Budget (the default ExperimentConfig): 30 000 environment steps per policy (6 environments x
-128 steps per update, 39 updates). On the project's 2-core VM: blind 132-149 steps/s,
-textureless ~91-108, norm2tex ~78-82 (every condition renders both sensors; the CNN's forward
-and backward passes make the difference), about 26 minutes for the whole run with the
-evaluations (docs/python.md). quick_config(): a smoke run of under a minute that writes every
-output.
+Budget (the default ExperimentConfig): 150 000 environment steps per policy (6 environments x
+128 steps per update, 195 updates). On the project's 2-core VM: blind 312 steps/s, textureless
+195, norm2tex 167 (every condition renders both sensors; the CNN's forward and backward passes
+make the difference), about 40 minutes for the whole run with the evaluations (docs/python.md).
+At 30 000 steps no policy learned to hold the cube. quick_config(): a smoke run of under a
+minute that writes every output.
 
 Also measured per material: the oracle (threshold_oracle: open up to the material's threshold
 and stay), evaluated on the same episodes -- the return a policy that holds the cube earns.

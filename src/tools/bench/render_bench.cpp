@@ -102,9 +102,12 @@ void BM_Render_Textured_HeldCube_Conformity(benchmark::State& state) {
 // between frames, so each frame starts with what the idle CPU left of its caches (warm loops
 // miss that). Manual time: the render only. `conformity` 0/1: the fixed-depth overlay or the
 // gel's conformity (the default sensor).
+// `rehearse_ms` > 0: the same render once more that long before each tick, its output unused
+// (what tactile_renderer's ~rehearse_ms does in real time).
 void BM_Render_HeldCube_Paced60Hz(benchmark::State& state) {
   norm2tex::SensorModel model = norm2tex::makeDigitSensorModel();
   model.conformity.enabled = state.range(0) != 0;
+  const auto rehearse = std::chrono::microseconds(state.range(1) * 1000);
   norm2tex::TactileRenderer renderer(model);
   renderer.setObject(cube(), atlas(), 0.2);
   const Eigen::Isometry3d pose = heldCubePose();
@@ -112,6 +115,10 @@ void BM_Render_HeldCube_Paced60Hz(benchmark::State& state) {
   Clock::time_point tick = Clock::now();
   for (auto _ : state) {
     tick += std::chrono::nanoseconds(16'666'667);
+    if (rehearse.count() > 0) {
+      std::this_thread::sleep_until(tick - rehearse);
+      benchmark::DoNotOptimize(renderer.render(pose, -1).image.data);
+    }
     std::this_thread::sleep_until(tick);
     const Clock::time_point start = Clock::now();
     const norm2tex::TactileFrame& out = renderer.render(pose, -1);
@@ -181,6 +188,53 @@ void BM_Stage_Shading(benchmark::State& state) {
   }
 }
 
+// The held cube's render (conformity on) stage by stage, each timed: `paced` 0 renders back to
+// back, 1 once per 60 Hz tick with the thread asleep in between. Which stages pay for the
+// wait is what the difference of their counters (ms per frame) shows. The stages are the
+// renderer's own objects in TactileRenderer::render()'s order; manual time: their sum.
+void BM_Render_HeldCube_Stages(benchmark::State& state) {
+  StageFixture f(true);
+  const bool paced = state.range(0) != 0;
+  norm2tex::ConformityOptions options;
+  options.enabled = true;
+  norm2tex::GelConformity conformity(options, f.model.mm_per_pixel);
+  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()),
+                               norm2tex::BackgroundSource::kSynthetic);
+  cv::Mat1f h_local;
+  using Clock = std::chrono::steady_clock;
+  enum { kRaster, kOverlay, kConformity, kGel, kShading, kStages };
+  const char* names[kStages] = {"raster_ms", "overlay_ms", "conformity_ms", "gel_ms", "shading_ms"};
+  double totals[kStages] = {};
+  Clock::time_point tick = Clock::now();
+  for (auto _ : state) {
+    if (paced) {
+      tick += std::chrono::nanoseconds(16'666'667);
+      std::this_thread::sleep_until(tick);
+    }
+    Clock::time_point t[kStages + 1];
+    t[0] = Clock::now();
+    f.rasterizer.rasterize(*f.mesh, f.pose, f.overlay.reachMm(), true, f.raster);
+    t[1] = Clock::now();
+    f.overlay.apply(f.raster, f.model.gel_thickness_mm, f.h_final, &h_local);
+    t[2] = Clock::now();
+    conformity.applyToFinal(f.raster.h_sensor_mm, h_local, f.overlay.betaMm(),
+                            f.raster.covered_box, 5.0, f.raster.gap_mm,
+                            f.model.gel_thickness_mm, f.h_final);
+    t[3] = Clock::now();
+    f.gel.apply(f.h_final, f.gel_mm);
+    t[4] = Clock::now();
+    cv::Mat3b image = shader.shade(f.gel_mm, -1);
+    benchmark::DoNotOptimize(image.data);
+    t[5] = Clock::now();
+    for (int k = 0; k < kStages; ++k)
+      totals[k] += std::chrono::duration<double, std::milli>(t[k + 1] - t[k]).count();
+    state.SetIterationTime(std::chrono::duration<double>(t[kStages] - t[0]).count());
+  }
+  for (int k = 0; k < kStages; ++k) {
+    state.counters[names[k]] = totals[k] / static_cast<double>(state.iterations());
+  }
+}
+
 BENCHMARK(BM_Render_Textureless)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_AtUvPole)->Unit(benchmark::kMillisecond)->MinTime(1.0);
@@ -192,7 +246,16 @@ BENCHMARK(BM_Render_Textured_HeldCube)
     ->MinTime(1.0);
 BENCHMARK(BM_Render_Textured_HeldCube_Conformity)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(BM_Render_HeldCube_Paced60Hz)
-    ->ArgName("conformity")
+    ->ArgNames({"conformity", "rehearse_ms"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 3})
+    ->Args({1, 5})
+    ->UseManualTime()
+    ->Iterations(180)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Render_HeldCube_Stages)
+    ->ArgName("paced")
     ->Arg(0)
     ->Arg(1)
     ->UseManualTime()

@@ -6,7 +6,11 @@
 // ticks of 60 Hz this measures, as p50 / p90 / p99 / max:
 //   - how late a thread sleeping to an absolute time (clock_nanosleep) wakes;
 //   - a hand-over through a pipe to a thread in epoll_wait (roscpp's poll-set signal), with
-//     both threads pinned to the same CPU, and to different CPUs.
+//     both threads pinned to the same CPU, and to different CPUs;
+//   - what a sleep costs the work after it: a pass over 4 MiB (the order of a render's working
+//     set) and a register-only arithmetic loop, each timed back to back and at every tick after
+//     sleeping to it. Where the memory pass is slower after the sleep and the arithmetic is not,
+//     the caches were emptied while the thread slept (tactile_renderer's ~rehearse_ms).
 // On bare metal all of these are tens of microseconds. On a virtual machine a wake-up of an
 // idle virtual CPU waits for the host to run it: that is the tail a frame's latency inherits.
 #include <sched.h>
@@ -115,6 +119,45 @@ std::vector<double> pipeHandOver(int frames, int sender_cpu, int receiver_cpu) {
   return hand_over;
 }
 
+/// Seconds of arithmetic on registers only (no memory traffic): a CPU that runs slower after
+/// a sleep shows here.
+double arithmeticMs() {
+  const std::int64_t start = nowNs();
+  double a = 1.0, b = 0.5;
+  for (int i = 0; i < 200'000; ++i) {
+    a = a * 1.0000001 + 1e-9;
+    b = b * 0.9999999 + 1e-9;
+  }
+  volatile double sink = a + b;
+  (void)sink;
+  return 1e-6 * static_cast<double>(nowNs() - start);
+}
+
+/// A read-modify-write of every cache line of `memory`.
+double memoryPassMs(std::vector<unsigned char>& memory) {
+  const std::int64_t start = nowNs();
+  for (std::size_t i = 0; i < memory.size(); i += 64) ++memory[i];
+  return 1e-6 * static_cast<double>(nowNs() - start);
+}
+
+/// The arithmetic loop and the 4 MiB pass, `frames` times back to back (`paced` false) or at
+/// each 60 Hz tick after sleeping to it, on CPU 0.
+void afterSleep(int frames, bool paced, std::vector<double>& arithmetic,
+                std::vector<double>& memory_pass) {
+  std::thread worker([&] {
+    pinTo(0);
+    std::vector<unsigned char> memory(4u << 20, 1);
+    memoryPassMs(memory);  // faulted in before timing
+    std::int64_t next = nowNs() + kPeriodNs;
+    for (int i = 0; i < frames; ++i, next += kPeriodNs) {
+      if (paced) sleepUntil(next);
+      arithmetic.push_back(arithmeticMs());
+      memory_pass.push_back(memoryPassMs(memory));
+    }
+  });
+  worker.join();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -133,5 +176,12 @@ int main(int argc, char** argv) {
   report("sleep to a tick (clock_nanosleep): lateness", timerLateness(frames));
   report("pipe -> epoll_wait hand-over, same CPU", pipeHandOver(frames, 0, 0));
   if (cpus > 1) report("pipe -> epoll_wait hand-over, other CPU", pipeHandOver(frames, 0, 1));
+  std::vector<double> arithmetic_loop, memory_loop, arithmetic_paced, memory_paced;
+  afterSleep(frames, false, arithmetic_loop, memory_loop);
+  afterSleep(frames, true, arithmetic_paced, memory_paced);
+  report("arithmetic, back to back", arithmetic_loop);
+  report("arithmetic, right after sleeping to a tick", arithmetic_paced);
+  report("4 MiB memory pass, back to back", memory_loop);
+  report("4 MiB memory pass, after sleeping to a tick", memory_paced);
   return 0;
 }

@@ -1,0 +1,38 @@
+"""roslaunch for the tests that start one: a free port for its master and a stop that always ends
+the launch, its nodes and master included (they run in the launch's own process group).
+
+Not a test module (pytest collects test_*.py only); the tests import it from this folder.
+"""
+
+import os
+import signal
+import subprocess
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def free_port(script=None):
+    """A TCP port nobody listens on, from the package's free_port script (the source tree's,
+    or `script`, e.g. an install space's)."""
+    script = script or os.path.join(REPO, "scripts", "free_port")
+    out = subprocess.run([script], capture_output=True, text=True, check=True).stdout
+    return int(out)
+
+
+def start(args, env, log):
+    """`roslaunch args...` in a process group of its own, output to the open file `log`."""
+    return subprocess.Popen(["roslaunch"] + list(args), env=env, stdout=log,
+                            stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def stop(launch, timeout_s=30):
+    """Ends a launch started with start_new_session: Ctrl-C to its group, as a user would, and
+    SIGKILL to the group if it has not ended within timeout_s. Returns its exit code."""
+    if launch.poll() is None:
+        os.killpg(launch.pid, signal.SIGINT)
+        try:
+            launch.communicate(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            os.killpg(launch.pid, signal.SIGKILL)
+            launch.communicate()
+    return launch.returncode
