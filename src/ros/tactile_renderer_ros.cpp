@@ -392,7 +392,6 @@ void TactileRendererRos::scheduleRehearsal(const ros::Time& stamp, const ros::Wa
   // (real time: simulated and wall time advance together). Not known before the second frame.
   const ros::Time previous = last_frame_.stamp;
   last_frame_.stamp = stamp;
-  last_frame_.received = received;
   if (previous.isZero() || stamp <= previous) return;
   const double period_s = (stamp - previous).toSec();
   if (period_s > 1.0) return;  // a pause, not a rate

@@ -133,7 +133,6 @@ class TactileRendererRos {
   struct LastFrame {
     std::uint64_t count = 0;  ///< frames received: a rehearsal after a newer frame is moot
     ros::Time stamp;
-    ros::WallTime received;
     Eigen::Isometry3d object_in_gel = Eigen::Isometry3d::Identity();
     std::int64_t noise_seed = -1;
     std::optional<double> normal_force_n;
