@@ -31,6 +31,7 @@ namespace norm2tex {
 namespace {
 
 using ros_params::badParameter;
+using ros_params::readParam;
 using ros_params::materialConfigPath;
 using ros_params::packageFile;
 using ros_params::text;
@@ -59,46 +60,46 @@ void fillState(const GripperSim& sim, std::int64_t frame, Response& response) {
 ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   ContactSimParams p;
   std::string mode = "real_time";
-  pnh.param<std::string>("mode", mode, mode);
+  readParam<std::string>(pnh, "mode", mode, mode);
   if (mode != "real_time" && mode != "synchronous") {
     badParameter("mode", "'" + mode + "'", "real_time, synchronous");
   }
   p.synchronous = mode == "synchronous";
-  pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
-  pnh.param<std::string>("mesh", p.mesh, "");
-  pnh.param("scale", p.scale, p.scale);
+  readParam<std::string>(pnh, "scene", p.scene, packageFile("config/scenes/cube.yaml"));
+  readParam<std::string>(pnh, "mesh", p.mesh, "");
+  readParam(pnh, "scale", p.scale, p.scale);
   if (!(p.scale > 0.0 && p.scale <= 1000.0)) badParameter("scale", text(p.scale), "(0, 1000]");
-  pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
-  pnh.param<std::string>("material", p.material, "wood");
+  readParam<std::string>(pnh, "sensor", p.sensor, packageFile("config/digit.yaml"));
+  readParam<std::string>(pnh, "material", p.material, "wood");
   if (p.material.empty()) p.material = ros_params::kNoMaterial;
   if (p.material != ros_params::kNoMaterial) {
     p.material_config = materialConfigPath(p.material, ", or none (then ~friction)");
   }
-  pnh.param("friction", p.friction, p.friction);
+  readParam(pnh, "friction", p.friction, p.friction);
   if (!(p.friction < 0.0 || p.friction <= 5.0) || std::isnan(p.friction)) {
     badParameter("friction", text(p.friction), "[0, 5], or < 0 for the material's");
   }
   int seed = 0;
-  pnh.param("seed", seed, 0);
+  readParam(pnh, "seed", seed, 0);
   if (seed < 0) badParameter("seed", text(seed), ">= 0");
   p.seed = seed;
-  pnh.param("height_offset", p.height_offset, std::nan(""));
-  pnh.param("physics_rate", p.physics_rate, p.physics_rate);
+  readParam(pnh, "height_offset", p.height_offset, std::nan(""));
+  readParam(pnh, "physics_rate", p.physics_rate, p.physics_rate);
   if (!(p.physics_rate >= 100.0 && p.physics_rate <= 100000.0)) {
     badParameter("physics_rate", text(p.physics_rate), "[100, 100000] Hz");
   }
-  pnh.param("frame_rate", p.frame_rate, p.frame_rate);
+  readParam(pnh, "frame_rate", p.frame_rate, p.frame_rate);
   if (!(p.frame_rate >= 1.0 && p.frame_rate <= 1000.0 && p.frame_rate <= p.physics_rate)) {
     badParameter("frame_rate", text(p.frame_rate), "[1, 1000] Hz and <= ~physics_rate");
   }
-  pnh.param("variant", p.variant, 0);
+  readParam(pnh, "variant", p.variant, 0);
   if (p.variant < 0) badParameter("variant", text(p.variant), ">= 0");
-  pnh.param("beta", p.beta, -1.0);
-  pnh.param<std::string>("scenario", p.scenario, p.scenario);
+  readParam(pnh, "beta", p.beta, -1.0);
+  readParam<std::string>(pnh, "scenario", p.scenario, p.scenario);
   readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
-  pnh.param("window", p.window, p.window);
+  readParam(pnh, "window", p.window, p.window);
   if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
-  pnh.param<std::string>("trace_file", p.trace_file, "");
+  readParam<std::string>(pnh, "trace_file", p.trace_file, "");
   return p;
 }
 

@@ -20,6 +20,7 @@ namespace norm2tex {
 namespace {
 
 using ros_params::badParameter;
+using ros_params::readParam;
 using ros_params::text;
 
 template <typename M>
@@ -38,25 +39,25 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
   if (!pnh.getParam("output_dir", p.output_dir) || p.output_dir.empty()) {
     badParameter("output_dir", "''", "a directory to write the bags into");
   }
-  pnh.param<std::string>("prefix", p.prefix, p.prefix);
-  pnh.param("shard", p.shard, p.shard);
+  readParam<std::string>(pnh, "prefix", p.prefix, p.prefix);
+  readParam(pnh, "shard", p.shard, p.shard);
   if (p.shard < 0) badParameter("shard", text(p.shard), ">= 0");
-  pnh.param("sensors", p.sensors, p.sensors);
+  readParam(pnh, "sensors", p.sensors, p.sensors);
   p.topics = {"/tf", "/tf_static", "/joint_states", "/clock", "episode"};
   for (const std::string& sensor : p.sensors) p.topics.push_back(sensor + "/background");
-  pnh.param("topics", p.topics, p.topics);
-  pnh.param<std::string>("compression", p.compression, p.compression);
+  readParam(pnh, "topics", p.topics, p.topics);
+  readParam<std::string>(pnh, "compression", p.compression, p.compression);
   if (p.compression != "lz4" && p.compression != "bz2" && p.compression != "none") {
     badParameter("compression", "'" + p.compression + "'", "lz4, bz2, none");
   }
-  pnh.param("samples", p.samples, p.samples);
+  readParam(pnh, "samples", p.samples, p.samples);
   if (p.samples < 0) badParameter("samples", text(p.samples), ">= 0 (0: no limit)");
-  pnh.param<std::string>("answer_as", p.answer_as, p.answer_as);
-  pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
-  pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
-  pnh.param("split_mb", p.split_mb, p.split_mb);
+  readParam<std::string>(pnh, "answer_as", p.answer_as, p.answer_as);
+  readParam<std::string>(pnh, "frame_topic", p.frame_topic, p.frame_topic);
+  readParam<std::string>(pnh, "answer_topic", p.answer_topic, p.answer_topic);
+  readParam(pnh, "split_mb", p.split_mb, p.split_mb);
   if (!(p.split_mb >= 0.0)) badParameter("split_mb", text(p.split_mb), ">= 0 MB (0: one bag)");
-  pnh.param("min_free_mb", p.min_free_mb, p.min_free_mb);
+  readParam(pnh, "min_free_mb", p.min_free_mb, p.min_free_mb);
   if (!(p.min_free_mb >= 0.0)) {
     badParameter("min_free_mb", text(p.min_free_mb), ">= 0 MB (0: write until a write fails)");
   }

@@ -11,18 +11,19 @@ namespace norm2tex {
 void readLockStepParams(const ros::NodeHandle& pnh, std::vector<std::string>& renderers,
                         double& render_timeout, double& ready_timeout) {
   using ros_params::badParameter;
+  using ros_params::readParam;
   using ros_params::text;
-  pnh.param("renderers", renderers, renderers);
+  readParam(pnh, "renderers", renderers, renderers);
   for (const std::string& name : renderers) {
     if (name.empty() || name.find(' ') != std::string::npos) {
       badParameter("renderers", "['" + name + "', ...]", "names such as digit_left");
     }
   }
-  pnh.param("render_timeout", render_timeout, render_timeout);
+  readParam(pnh, "render_timeout", render_timeout, render_timeout);
   if (!(render_timeout > 0.0 && render_timeout <= 600.0)) {
     badParameter("render_timeout", text(render_timeout), "(0, 600] s");
   }
-  pnh.param("ready_timeout", ready_timeout, ready_timeout);
+  readParam(pnh, "ready_timeout", ready_timeout, ready_timeout);
   if (!(ready_timeout > 0.0 && ready_timeout <= 3600.0)) {
     badParameter("ready_timeout", text(ready_timeout), "(0, 3600] s");
   }

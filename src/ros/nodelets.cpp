@@ -9,6 +9,7 @@
 #include "contact_sim.hpp"
 #include "dataset_recorder.hpp"
 #include "launch_end.hpp"
+#include "params.hpp"
 #include "probe_sim.hpp"
 #include "norm2tex/common/error.hpp"
 #include "tactile_renderer_ros.hpp"
@@ -76,7 +77,7 @@ class DatasetRecorderNodelet : public nodelet::Nodelet {
       ros::shutdown();
       return;
     }
-    getPrivateNodeHandle().param("shutdown_when_done", shutdown_when_done_, true);
+    ros_params::readParam(getPrivateNodeHandle(), "shutdown_when_done", shutdown_when_done_, true);
     // On the recorder's own (single-threaded) queue: never concurrent with its callbacks.
     done_timer_ = getNodeHandle().createWallTimer(ros::WallDuration(0.01), [this](const auto&) {
       if (!recorder_->done()) return;

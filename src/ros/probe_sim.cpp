@@ -21,6 +21,7 @@ namespace norm2tex {
 namespace {
 
 using ros_params::badParameter;
+using ros_params::readParam;
 using ros_params::packageFile;
 using ros_params::text;
 
@@ -51,53 +52,53 @@ std::vector<std::string> materialList(const std::string& spec) {
 
 ProbeSimParams readProbeSimParams(const ros::NodeHandle& pnh) {
   ProbeSimParams p;
-  pnh.param<std::string>("sensor_name", p.sensor_name, p.sensor_name);
+  readParam<std::string>(pnh, "sensor_name", p.sensor_name, p.sensor_name);
   if (p.sensor_name.empty() || p.sensor_name.find(' ') != std::string::npos) {
     badParameter("sensor_name", "'" + p.sensor_name + "'", "a topic name such as digit_left");
   }
-  pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
-  pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
-  pnh.param<std::string>("mesh", p.mesh, "");
-  pnh.param("scale", p.scale, p.scale);
+  readParam<std::string>(pnh, "sensor", p.sensor, packageFile("config/digit.yaml"));
+  readParam<std::string>(pnh, "scene", p.scene, packageFile("config/scenes/cube.yaml"));
+  readParam<std::string>(pnh, "mesh", p.mesh, "");
+  readParam(pnh, "scale", p.scale, p.scale);
   if (!(p.scale > 0.0 && p.scale <= 1000.0)) badParameter("scale", text(p.scale), "(0, 1000]");
   std::string material = "wood";
-  pnh.param<std::string>("material", material, material);
+  readParam<std::string>(pnh, "material", material, material);
   p.materials = materialList(material);
   for (const std::string& name : p.materials) ros_params::materialConfigPath(name, ", all");
-  pnh.param("variants", p.variants, p.variants);
+  readParam(pnh, "variants", p.variants, p.variants);
   if (p.variants == 0 || p.variants > 10000) {
     badParameter("variants", text(p.variants), "[1, 10000], or < 0 for each material's count");
   }
-  pnh.param("samples", p.samples, p.samples);
+  readParam(pnh, "samples", p.samples, p.samples);
   if (p.samples < 1) badParameter("samples", text(p.samples), ">= 1 images per material");
   int seed = 0;
-  pnh.param("seed", seed, seed);
+  readParam(pnh, "seed", seed, seed);
   if (seed < 0) badParameter("seed", text(seed), ">= 0");
   p.seed = seed;
-  pnh.param("num_shards", p.num_shards, p.num_shards);
+  readParam(pnh, "num_shards", p.num_shards, p.num_shards);
   if (p.num_shards < 1) badParameter("num_shards", text(p.num_shards), ">= 1");
-  pnh.param("shard", p.shard, p.shard);
+  readParam(pnh, "shard", p.shard, p.shard);
   if (p.shard < 0 || p.shard >= p.num_shards) {
     badParameter("shard", text(p.shard), "[0, ~num_shards - 1]");
   }
-  pnh.param("press_depth_min", p.probe.press_depth_min_m, p.probe.press_depth_min_m);
-  pnh.param("press_depth_max", p.probe.press_depth_max_m, p.probe.press_depth_max_m);
-  pnh.param("slides", p.probe.slides_per_press, p.probe.slides_per_press);
-  pnh.param("slide_step", p.probe.slide_step_max_m, p.probe.slide_step_max_m);
+  readParam(pnh, "press_depth_min", p.probe.press_depth_min_m, p.probe.press_depth_min_m);
+  readParam(pnh, "press_depth_max", p.probe.press_depth_max_m, p.probe.press_depth_max_m);
+  readParam(pnh, "slides", p.probe.slides_per_press, p.probe.slides_per_press);
+  readParam(pnh, "slide_step", p.probe.slide_step_max_m, p.probe.slide_step_max_m);
   try {
     validate(p.probe);
   } catch (const Error& e) {
     throw Error(std::string(e.what()) +
                 " (~press_depth_min/max, ~slides, ~slide_step set these, in metres)");
   }
-  pnh.param("beta", p.beta, p.beta);
-  pnh.param("frame_rate", p.frame_rate, p.frame_rate);
+  readParam(pnh, "beta", p.beta, p.beta);
+  readParam(pnh, "frame_rate", p.frame_rate, p.frame_rate);
   if (!(p.frame_rate >= 1.0 && p.frame_rate <= 1000.0)) {
     badParameter("frame_rate", text(p.frame_rate), "[1, 1000] Hz");
   }
   readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
-  pnh.param("autostart", p.autostart, p.autostart);
-  pnh.param("window", p.window, p.window);
+  readParam(pnh, "autostart", p.autostart, p.autostart);
+  readParam(pnh, "window", p.window, p.window);
   if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
   return p;
 }

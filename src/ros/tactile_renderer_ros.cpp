@@ -27,6 +27,7 @@ namespace norm2tex {
 namespace {
 
 using ros_params::badParameter;
+using ros_params::readParam;
 using ros_params::packageFile;
 
 ros::NodeHandle onQueue(ros::NodeHandle nh, ros::CallbackQueue* queue) {
@@ -38,62 +39,62 @@ ros::NodeHandle onQueue(ros::NodeHandle nh, ros::CallbackQueue* queue) {
 
 TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   TactileRendererParams p;
-  pnh.param<std::string>("sensor_name", p.sensor_name, p.sensor_name);
+  readParam<std::string>(pnh, "sensor_name", p.sensor_name, p.sensor_name);
   if (p.sensor_name.empty() || p.sensor_name.find(' ') != std::string::npos) {
     badParameter("sensor_name", "'" + p.sensor_name + "'", "a topic name such as digit_left");
   }
-  pnh.param<std::string>("sensor", p.sensor, packageFile("config/digit.yaml"));
-  pnh.param<std::string>("gel_frame", p.gel_frame, p.sensor_name + "_gel");
-  pnh.param<std::string>("object_frame", p.object_frame, p.object_frame);
-  pnh.param<std::string>("scene", p.scene, packageFile("config/scenes/cube.yaml"));
-  pnh.param<std::string>("mesh", p.mesh, "");
-  pnh.param("scale", p.scale, p.scale);
-  pnh.param<std::string>("normal_map", p.normal_map, "");
-  pnh.param<std::string>("convention", p.convention, p.convention);
-  pnh.param<std::string>("atlas", p.atlas, "");
+  readParam<std::string>(pnh, "sensor", p.sensor, packageFile("config/digit.yaml"));
+  readParam<std::string>(pnh, "gel_frame", p.gel_frame, p.sensor_name + "_gel");
+  readParam<std::string>(pnh, "object_frame", p.object_frame, p.object_frame);
+  readParam<std::string>(pnh, "scene", p.scene, packageFile("config/scenes/cube.yaml"));
+  readParam<std::string>(pnh, "mesh", p.mesh, "");
+  readParam(pnh, "scale", p.scale, p.scale);
+  readParam<std::string>(pnh, "normal_map", p.normal_map, "");
+  readParam<std::string>(pnh, "convention", p.convention, p.convention);
+  readParam<std::string>(pnh, "atlas", p.atlas, "");
   // A material unless a texture file is given. "none" is '' in a word: roslaunch drops empty
   // argument values, so a launch file cannot pass ''.
-  pnh.param<std::string>("material", p.material,
+  readParam<std::string>(pnh, "material", p.material,
                          p.normal_map.empty() && p.atlas.empty() ? "wood" : "");
   if (p.material == ros_params::kNoMaterial) p.material.clear();
   if (!p.material.empty()) {
     p.material_config = ros_params::materialConfigPath(
         p.material, ", or none (the mesh's own texture, or ~normal_map or ~atlas)");
   }
-  pnh.param("variant", p.variant, 0);
+  readParam(pnh, "variant", p.variant, 0);
   if (p.variant < 0) badParameter("variant", std::to_string(p.variant), ">= 0");
-  pnh.param("material_seed", p.material_seed, 0);
+  readParam(pnh, "material_seed", p.material_seed, 0);
   if (p.material_seed < 0) badParameter("material_seed", std::to_string(p.material_seed), ">= 0");
-  pnh.param("beta", p.beta, p.beta);
+  readParam(pnh, "beta", p.beta, p.beta);
   if (!(p.beta < 0.0 || p.beta <= 2.0)) {
     badParameter("beta", std::to_string(p.beta), "[0, 2] mm, or < 0 for the material's");
   }
-  pnh.param<std::string>("background", p.background, "");
-  pnh.param("noise_seed", p.noise_seed, 0);
-  pnh.param("publish_mask", p.publish_mask, false);
-  pnh.param("tf_timeout", p.tf_timeout, p.tf_timeout);
+  readParam<std::string>(pnh, "background", p.background, "");
+  readParam(pnh, "noise_seed", p.noise_seed, 0);
+  readParam(pnh, "publish_mask", p.publish_mask, false);
+  readParam(pnh, "tf_timeout", p.tf_timeout, p.tf_timeout);
   if (!(p.tf_timeout > 0.0 && p.tf_timeout <= 60.0)) {
     badParameter("tf_timeout", std::to_string(p.tf_timeout), "(0, 60] s");
   }
-  pnh.param("queue_size", p.queue_size, p.queue_size);
+  readParam(pnh, "queue_size", p.queue_size, p.queue_size);
   if (p.queue_size < 1 || p.queue_size > 10000) {
     badParameter("queue_size", std::to_string(p.queue_size), "[1, 10000] messages");
   }
-  pnh.param("opencv_threads", p.opencv_threads, p.opencv_threads);
+  readParam(pnh, "opencv_threads", p.opencv_threads, p.opencv_threads);
   if (p.opencv_threads < -1 || p.opencv_threads == 0 || p.opencv_threads > 64) {
     badParameter("opencv_threads", std::to_string(p.opencv_threads), "1 to 64, or -1");
   }
-  pnh.param<std::string>("frame_topic", p.frame_topic, p.frame_topic);
-  pnh.param<std::string>("answer_topic", p.answer_topic, p.answer_topic);
-  pnh.param("texture_from_frame", p.texture_from_frame, p.texture_from_frame);
-  pnh.param<std::string>("trace_file", p.trace_file, "");
-  pnh.param("cpu", p.cpu, p.cpu);
+  readParam<std::string>(pnh, "frame_topic", p.frame_topic, p.frame_topic);
+  readParam<std::string>(pnh, "answer_topic", p.answer_topic, p.answer_topic);
+  readParam(pnh, "texture_from_frame", p.texture_from_frame, p.texture_from_frame);
+  readParam<std::string>(pnh, "trace_file", p.trace_file, "");
+  readParam(pnh, "cpu", p.cpu, p.cpu);
   const int cpus = static_cast<int>(std::thread::hardware_concurrency());
   if (p.cpu < -1 || p.cpu >= std::max(cpus, 1) || p.cpu >= CPU_SETSIZE) {
     badParameter("cpu", std::to_string(p.cpu),
                  "-1 (any CPU) or a CPU of this machine, 0 to " + std::to_string(cpus - 1));
   }
-  pnh.param("rehearse_ms", p.rehearse_ms, p.rehearse_ms);
+  readParam(pnh, "rehearse_ms", p.rehearse_ms, p.rehearse_ms);
   if (!(p.rehearse_ms >= 0.0 && p.rehearse_ms <= 100.0)) {
     badParameter("rehearse_ms", std::to_string(p.rehearse_ms), "0 (off) to 100 ms");
   }

@@ -425,6 +425,10 @@ TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
       {"_cpu:=100000", "~cpu"},  // more CPUs than any machine: named, not a silent no-op
       {"_rehearse_ms:=-1", "~rehearse_ms"},
       {"_rehearse_ms:=1000", "~rehearse_ms"},
+      // Of the wrong type: roscpp's param() would take the default without a word.
+      {"_rehearse_ms:=.nan", "~rehearse_ms = .nan is not valid; valid: a number"},
+      {"_variant:=first", "~variant = first is not valid; valid: an integer"},
+      {"_publish_mask:=3", "~publish_mask = 3 is not valid; valid: true or false"},
   };
   for (const Case& c : cases) {
     std::string output;
