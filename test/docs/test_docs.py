@@ -8,7 +8,7 @@
   - every list of the recorder's manifest `stop_reason`s names exactly those the code writes (the
     constants of src/ros/dataset_recorder.hpp; src/ros writes no other string as one);
   - the parameter tables of docs/ros.md ("private parameter" tables under a node's heading) list
-    exactly the private parameters the node's code reads (pnh.param / getParam in src/ros/), and
+    exactly the private parameters the node's code reads (readParam / pnh.param / getParam in src/ros/), and
     the launch-argument tables ("launch arg" tables under a launch file's heading) exactly the
     arguments the launch file takes.
 
@@ -276,10 +276,14 @@ def documented_launch_args(text):
 _READ = re.compile(r"\b(?:pnh|private_nh_?|getPrivateNodeHandle\(\))\s*\.\s*"
                    r"(?:param|getParam|getParamCached|hasParam|searchParam)\b\s*"
                    r"(?:<[^;()]*>)?\s*\(\s*\"([^\"]+)\"")
+# ros_params::readParam(pnh, "name", ...): the nodes' typed read (src/ros/params.hpp).
+_TYPED_READ = re.compile(r"\breadParam\s*(?:<[^;()]*>)?\s*\(\s*"
+                         r"(?:pnh|private_nh_?|getPrivateNodeHandle\(\))\s*,\s*\"([^\"]+)\"")
 
 
 def params_read(source_text):
-    return set(_READ.findall(re.sub(r"//.*", "", source_text)))
+    code = re.sub(r"//.*", "", source_text)
+    return set(_READ.findall(code)) | set(_TYPED_READ.findall(code))
 
 
 def code_params(ros_dir):
@@ -472,8 +476,11 @@ class CheckerCatchesBrokenPages(unittest.TestCase):
     def test_code_reads_are_found(self):
         src = ('pnh.param<std::string>("a", x, "d");\n  pnh.param("b", y, 1);\n'
                'if (!pnh.getParam("c", z)) {}\n getPrivateNodeHandle().param("d", w, true);\n'
-               '// pnh.param("commented", q, 0);\n nh_.param("global", g, 0);\n')
-        self.assertEqual(params_read(src), {"a", "b", "c", "d"})
+               '// pnh.param("commented", q, 0);\n nh_.param("global", g, 0);\n'
+               'readParam<std::string>(pnh, "e", v, "");\n'
+               'ros_params::readParam(getPrivateNodeHandle(), "f", b, true);\n'
+               '// readParam(pnh, "commented", q, 0);\n readParam(nh_, "global", g, 0);\n')
+        self.assertEqual(params_read(src), {"a", "b", "c", "d", "e", "f"})
 
 
 if __name__ == "__main__":
