@@ -8,18 +8,12 @@
 
 #include <btBulletDynamicsCommon.h>
 
-#include <BulletCollision/CollisionShapes/btShapeHull.h>
-
 #include "norm2tex/common/error.hpp"
-#include "sim/convex_decomposition.hpp"
+#include "sim/object_collision.hpp"
 
 namespace norm2tex {
 namespace {
 
-// Bullet's default 4 cm margins are larger than the gel's whole range: keep them far below the
-// indentations we resolve (box margins sit inside the box, so boxes stay exact).
-constexpr double kBoxMargin = 2e-4;
-constexpr double kHullMargin = 2e-5;
 // The open gripper must clear the object by this much on each side.
 constexpr double kSeatClearance = 1e-3;
 // After the fingers reach the grasp command, the contact settles this long before gravity.
@@ -27,9 +21,6 @@ constexpr double kGraspHoldS = 0.1;
 // A gel contact point that slides this far along the gel, or separates this far, is dropped
 // (Bullet's contact breaking threshold for the package's own manifolds).
 constexpr double kContactBreakingM = 3e-4;
-// "auto" collision decomposes a mesh whose hull bridges a hollow deeper than this on a side
-// facing the gels: the tolerance the physics keeps to the rendered indentation.
-constexpr double kMaxHullDeviationM = 0.15e-3;
 // An object's side must overlap the gel pads by this much (height) at a height offset reset()
 // accepts.
 constexpr double kMinPadOverlap = 1e-3;
@@ -87,48 +78,6 @@ struct GripperSim::World {
   }
 };
 
-namespace {
-
-std::vector<Eigen::Vector3d> verticesAbout(const TexturedMesh& mesh, const Eigen::Vector3d& centre) {
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(mesh.vertices().size());
-  for (const Eigen::Vector3f& v : mesh.vertices()) points.push_back(v.cast<double>() - centre);
-  return points;
-}
-
-// Bullet's shape of a convex polytope, for the floor and the inertia (the gels use the polytope
-// itself). btShapeHull keeps big meshes cheap against the floor.
-std::unique_ptr<btCollisionShape> bulletHull(const std::vector<Eigen::Vector3d>& points) {
-  btConvexHullShape full;
-  for (const Eigen::Vector3d& p : points) full.addPoint(toBt(p), false);
-  full.recalcLocalAabb();
-  full.setMargin(0.0);
-  btShapeHull reducer(&full);
-  reducer.buildHull(0.0);
-  auto hull = std::make_unique<btConvexHullShape>();
-  for (int i = 0; i < reducer.numVertices(); ++i) {
-    hull->addPoint(reducer.getVertexPointer()[i], false);
-  }
-  hull->recalcLocalAabb();
-  hull->setMargin(kHullMargin);
-  return hull;
-}
-
-std::unique_ptr<btCollisionShape> roundShape(const ObjectMesh& object) {
-  const double r = object.radius_m, h = object.half_length_m;
-  std::unique_ptr<btCollisionShape> shape;
-  if (object.shape == ObjectMesh::Shape::kSphere) {
-    shape = std::make_unique<btSphereShape>(r);
-  } else if (object.shape == ObjectMesh::Shape::kCapsule) {
-    if (object.axis == 0) shape = std::make_unique<btCapsuleShapeX>(r, 2 * h);
-    if (object.axis == 1) shape = std::make_unique<btCapsuleShape>(r, 2 * h);
-    if (object.axis == 2) shape = std::make_unique<btCapsuleShapeZ>(r, 2 * h);
-  }
-  return shape;
-}
-
-}  // namespace
-
 GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   validate(config_);
   object_ = loadObjectMesh(config_.object.mesh, config_.object.scale);
@@ -169,68 +118,14 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
 GripperSim::~GripperSim() = default;
 
 void GripperSim::makeCollision(const Eigen::Vector3d& centre) {
-  const std::string& mode = config_.object.collision;
-  const ObjectMesh& o = object_;
-  if (mode == "box" || (mode == "auto" && o.shape == ObjectMesh::Shape::kBox)) {
-    const Eigen::Vector3d half = o.mesh.bounds().sizes().cast<double>() / 2.0;
-    auto box = std::make_unique<btBoxShape>(toBt(half));
-    box->setMargin(std::min(kBoxMargin, 0.25 * half.minCoeff()));
-    object_shapes_.push_back(std::move(box));
-    std::vector<Eigen::Vector3d> corners;
-    for (int k = 0; k < 8; ++k) {
-      corners.push_back(half.cwiseProduct(
-          Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
-    }
-    contact_parts_.push_back(ConvexPolytope::hullOf(corners));
-    collision_.kind = "box";
-    return;
-  }
-  if (mode == "auto" &&
-      (o.shape == ObjectMesh::Shape::kSphere || o.shape == ObjectMesh::Shape::kCapsule)) {
-    object_shapes_.push_back(roundShape(o));
-    Capsule capsule;
-    capsule.radius = o.radius_m;
-    if (o.shape == ObjectMesh::Shape::kCapsule) {
-      capsule.b[o.axis] = o.half_length_m;
-      capsule.a[o.axis] = -o.half_length_m;
-    }
-    contact_capsule_ = capsule;
-    collision_.kind = shapeName(o.shape);
-    return;
-  }
-  const std::vector<Eigen::Vector3d> points = verticesAbout(o.mesh, centre);
-  ConvexPolytope hull = ConvexPolytope::hullOf(points);
-  // A flat gel meets a concave mesh where its hull does, to the same depth (the deepest point of
-  // a body in a half-space is a hull vertex); only where the hull bridges a hollow within the
-  // gel's reach (the law's deepest point) on the sides facing the gels (world +-y: the object
-  // starts unrotated) does the contact's footprint differ from the mesh's.
-  if (mode == "auto") {
-    collision_.hull_deviation_m = hullDeviation(hull, points, Eigen::Vector3d::UnitY(),
-                                                config_.gel_law.points().back().first);
-  }
-  if (mode == "decomposition" ||
-      (mode == "auto" && collision_.hull_deviation_m > kMaxHullDeviationM)) {
-    object_shapes_ = decomposeConvex(o.mesh, centre, kHullMargin);
-    for (size_t i = 0; i + 1 < object_shapes_.size(); ++i) {
-      const auto& part = static_cast<const btConvexHullShape&>(*object_shapes_[i]);
-      std::vector<Eigen::Vector3d> part_points;
-      for (int k = 0; k < part.getNumPoints(); ++k) {
-        part_points.push_back(toEigen(part.getUnscaledPoints()[k]));
-      }
-      try {
-        contact_parts_.push_back(ConvexPolytope::hullOf(part_points));
-      } catch (const Error&) {
-        // A flat sliver (HACD can return one): nothing a gel could press into.
-      }
-    }
-    if (contact_parts_.empty()) throw Error("convex decomposition of the object mesh produced no solid part");
-    collision_.kind = "decomposition";
-    collision_.parts = static_cast<int>(contact_parts_.size());
-    return;
-  }
-  object_shapes_.push_back(bulletHull(points));
-  contact_parts_.push_back(std::move(hull));
-  collision_.kind = "hull";
+  // The object starts unrotated: the gels face its world +-y sides.
+  ObjectCollisionShapes shapes =
+      makeObjectCollision(object_, config_.object.collision, centre,
+                          config_.gel_law.points().back().first, Eigen::Vector3d::UnitY());
+  object_shapes_ = std::move(shapes.shapes);
+  contact_parts_ = std::move(shapes.contact_parts);
+  contact_capsule_ = shapes.contact_capsule;
+  collision_ = shapes.collision;
 }
 
 void GripperSim::findHeightOffsetRange(const Eigen::Vector3d& centre) {

@@ -1,0 +1,807 @@
+#include "norm2tex/sim/hand_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <btBulletDynamicsCommon.h>
+
+#include "common/error_messages.hpp"
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+#include "sim/object_collision.hpp"
+
+namespace norm2tex {
+namespace {
+
+// A gel contact point that slides this far along the gel, or separates this far, is dropped
+// (as GripperSim's).
+constexpr double kContactBreakingM = 3e-4;
+// Collision groups: links meet the object (not each other, not the floor: they are placed by
+// the drives); gels never collide through Bullet (the package makes their contacts).
+constexpr int kLinkGroup = 1 << 5;
+constexpr int kGelGroup = 1 << 6;
+constexpr int kObjectGroup = 1 << 7;
+
+btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
+Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+
+btTransform toBt(const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.rotation());
+  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), toBt(pose.translation()));
+}
+
+Eigen::Isometry3d toEigen(const btTransform& t) {
+  const btQuaternion q = t.getRotation();
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
+  pose.translation() = toEigen(t.getOrigin());
+  return pose;
+}
+
+bool isPose(const Eigen::Isometry3d& pose) {
+  return pose.matrix().allFinite() &&
+         (pose.linear() * pose.linear().transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
+         pose.linear().determinant() > 0.0;
+}
+
+}  // namespace
+
+struct HandSim::World {
+  btDefaultCollisionConfiguration collision_config;
+  btCollisionDispatcher dispatcher{&collision_config};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &collision_config};
+
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;  // every shape the bodies use
+  std::unique_ptr<btRigidBody> floor;
+  /// Per link: its kinematic body, or null when it has no collision geometry.
+  std::vector<std::unique_ptr<btRigidBody>> links;
+  std::vector<std::unique_ptr<btRigidBody>> gels;
+  std::unique_ptr<btRigidBody> object;
+  std::vector<std::unique_ptr<btCollisionShape>> object_shapes;
+  std::vector<ConvexPolytope> contact_parts;
+  std::optional<Capsule> contact_capsule;
+  /// Per gel, one manifold per convex part of the object (body 0 the gel, body 1 the object).
+  std::vector<std::vector<btPersistentManifold*>> manifolds;
+
+  ~World() {
+    for (auto& gel_manifolds : manifolds) {
+      for (btPersistentManifold* manifold : gel_manifolds) dispatcher.releaseManifold(manifold);
+    }
+    if (object) world.removeRigidBody(object.get());
+    for (auto& gel : gels) world.removeRigidBody(gel.get());
+    for (auto& link : links) {
+      if (link) world.removeRigidBody(link.get());
+    }
+    if (floor) world.removeRigidBody(floor.get());
+  }
+};
+
+HandSimConfig makeHandSimConfig(const std::string& hand_yaml, const GripperSimConfig& scene) {
+  HandSimConfig config;
+  config.hand = loadHandConfig(hand_yaml);
+  config.object = scene.object;
+  config.physics = scene.physics;
+  config.gel_law = scene.gel_law;
+  config.gel_width_m = scene.gel_width_m;
+  config.gel_height_m = scene.gel_height_m;
+  config.gel_thickness_m = scene.gel_thickness_m;
+  return config;
+}
+
+HandSim::HandSim(const HandSimConfig& config) : config_(config) {
+  if (!isPose(config_.hand.base_pose)) throw Error("hand.base_pose is not a finite rigid pose");
+  if (!isPose(config_.object_pose)) throw Error("the object's pose is not a finite rigid pose");
+  description_ = loadHandDescription(config_.hand.urdf_path, config_.hand.package_paths,
+                                     config_.hand.root_link);
+  warnings_ = description_.warnings;
+  base_pose_ = config_.hand.base_pose;
+  for (const SensorMount& mount : config_.hand.sensors) {
+    const int link = description_.linkIndex(mount.link);
+    if (link < 0) {
+      std::string links;
+      for (const HandLink& l : description_.links) links += (links.empty() ? "" : ", ") + l.name;
+      throw Error("sensor '" + mount.name + "': link '" + mount.link + "' is not in the hand " +
+                  "(" + config_.hand.urdf_path + "; links: " + links + ")");
+    }
+    if (std::count(sensor_links_.begin(), sensor_links_.end(), link)) {
+      throw Error("sensor '" + mount.name + "': link '" + mount.link + "' carries another sensor");
+    }
+    sensor_links_.push_back(link);
+  }
+  resolveDrives();
+
+  const size_t joints = description_.joints.size();
+  q_.assign(joints, 0.0);
+  load_.assign(joints, 0.0);
+  contact_stiffness_.assign(joints, 0.0);
+  for (const auto& [name, value] : config_.hand.initial_positions) {
+    const int j = description_.jointIndex(name);
+    if (j < 0 || !description_.joints[j].movable() || description_.joints[j].mimic_master >= 0) {
+      throw Error("initial_positions." + name + ": not an actuated joint of the hand");
+    }
+    q_[j] = value;
+  }
+  for (size_t j = 0; j < joints; ++j) {
+    bool clamped = false;
+    if (description_.joints[j].movable()) q_[j] = clampToLimits(static_cast<int>(j), q_[j], clamped);
+  }
+  for (size_t j = 0; j < joints; ++j) {
+    const HandJoint& joint = description_.joints[j];
+    if (joint.mimic_master >= 0) {
+      q_[j] = joint.mimic_multiplier * q_[joint.mimic_master] + joint.mimic_offset;
+    }
+  }
+  drive_q_ = q_;
+  target_ = q_;
+  // The movable joints from the root to each link.
+  link_joints_.resize(description_.links.size());
+  for (size_t l = 1; l < description_.links.size(); ++l) {
+    const HandJoint& joint = description_.joints[description_.links[l].parent_joint];
+    link_joints_[l] = link_joints_[joint.parent_link];
+    if (joint.movable()) link_joints_[l].push_back(description_.links[l].parent_joint);
+  }
+  link_poses_.assign(description_.links.size(), Eigen::Isometry3d::Identity());
+  forwardKinematics();
+
+  object_ = loadObjectMesh(config_.object.mesh, config_.object.scale);
+  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
+  object_in_body_ = Eigen::Translation3d(-centre);
+  checkMounts();
+  buildWorld();
+}
+
+HandSim::~HandSim() = default;
+
+void HandSim::resolveDrives() {
+  drives_.assign(description_.joints.size(), Drive{});
+  for (const auto& [name, drive] : config_.hand.drives) {
+    const int j = description_.jointIndex(name);
+    if (j < 0) throw Error("joints." + name + ": no such joint in the hand");
+  }
+  for (size_t j = 0; j < description_.joints.size(); ++j) {
+    const HandJoint& joint = description_.joints[j];
+    if (!joint.movable() || joint.mimic_master >= 0) {
+      if (joint.mimic_master < 0) continue;
+    } else {
+      actuated_.push_back(static_cast<int>(j));
+      actuated_names_.push_back(joint.name);
+    }
+    const auto own = config_.hand.drives.find(joint.name);
+    const JointDriveOptions none;
+    const JointDriveOptions& specific = own != config_.hand.drives.end() ? own->second : none;
+    const JointDriveOptions& fallback = config_.hand.default_drive;
+    const auto pick = [&](double yaml_own, double urdf, double yaml_default) {
+      if (yaml_own >= 0) return yaml_own;
+      if (yaml_default >= 0) return yaml_default;
+      return urdf;
+    };
+    Drive& d = drives_[j];
+    d.effort = pick(specific.effort, joint.effort, fallback.effort);
+    d.velocity = pick(specific.velocity, joint.velocity, fallback.velocity);
+    d.stiffness = std::max(0.0, pick(specific.stiffness, 0.0, fallback.stiffness));
+    if (joint.mimic_master >= 0) continue;  // a mimic joint moves with its master
+    if (!(d.effort > 0.0) || !(d.velocity > 0.0)) {
+      throw Error("joint '" + joint.name + "' has no " + (d.effort > 0.0 ? "velocity" : "effort") +
+                  " limit (the URDF gives 0): set joints." + joint.name + " or joints.default " +
+                  "{effort, velocity} in the hand yaml");
+    }
+  }
+}
+
+double HandSim::clampToLimits(int j, double value, bool& clamped) const {
+  const HandJoint& joint = description_.joints[j];
+  const double out = std::clamp(value, joint.lower, joint.upper);
+  clamped = out != value;
+  return out;
+}
+
+void HandSim::forwardKinematics() {
+  link_poses_[0] = base_pose_;
+  for (size_t l = 1; l < description_.links.size(); ++l) {
+    const int j = description_.links[l].parent_joint;
+    const HandJoint& joint = description_.joints[j];
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    if (joint.type == HandJoint::Type::kPrismatic) {
+      motion.translation() = joint.axis * q_[j];
+    } else if (joint.movable()) {
+      motion.linear() = Eigen::AngleAxisd(q_[j], joint.axis).toRotationMatrix();
+    }
+    link_poses_[l] = link_poses_[joint.parent_link] * joint.origin * motion;
+  }
+}
+
+Eigen::Isometry3d HandSim::gelInLink(int sensor) const {
+  return config_.hand.sensors[sensor].digit_in_link * gelInDigit();
+}
+
+Eigen::Isometry3d HandSim::gelInWorld(int sensor) const {
+  return link_poses_[sensor_links_[sensor]] * gelInLink(sensor);
+}
+
+Eigen::Isometry3d HandSim::objectInWorld() const {
+  return toEigen(world_->object->getWorldTransform()) * object_in_body_;
+}
+
+double HandSim::jointPosition(const std::string& name) const {
+  const int j = description_.jointIndex(name);
+  if (j < 0) throw Error("no joint '" + name + "' in the hand");
+  return q_[j];
+}
+
+void HandSim::checkMounts() {
+  // TACTO's DIGIT link mesh includes the gel: its front over the pad should lie at, or a little
+  // behind, the gel surface. A gel far in front of its link, or one the link pokes through,
+  // is a gel pose that does not match the mesh.
+  checks_.assign(sensor_links_.size(), SensorMountCheck{});
+  for (size_t s = 0; s < sensor_links_.size(); ++s) {
+    const HandLink& link = description_.links[sensor_links_[s]];
+    const Eigen::Isometry3d link_in_gel = gelInLink(static_cast<int>(s)).inverse();
+    double front = -std::numeric_limits<double>::infinity();
+    for (const HandCollision& c : link.collisions) {
+      if (c.kind != HandCollision::Kind::kMesh) continue;
+      for (const Eigen::Vector3d& v : c.mesh_vertices) {
+        const Eigen::Vector3d p = link_in_gel * (c.origin * v);
+        if (std::abs(p.x()) <= config_.gel_width_m / 2 && std::abs(p.y()) <= config_.gel_height_m / 2) {
+          front = std::max(front, p.z());
+        }
+      }
+    }
+    SensorMountCheck& check = checks_[s];
+    if (!std::isfinite(front)) {
+      check.gel_in_front_of_mesh_m = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    check.gel_in_front_of_mesh_m = -front;
+    if (-front < -0.5e-3 || -front > config_.gel_thickness_m) {
+      std::ostringstream message;
+      message << "sensor '" << config_.hand.sensors[s].name << "': the gel surface lies "
+              << -front * 1e3 << " mm in front of link '" << link.name
+              << "''s collision mesh over the pad (expected 0 to the gel's thickness, "
+              << config_.gel_thickness_m * 1e3 << " mm): check its gel pose in rviz";
+      warnings_.push_back(message.str());
+    }
+  }
+}
+
+void HandSim::buildWorld() {
+  world_ = std::make_unique<World>();
+  World& w = *world_;
+  const PhysicsOptions& p = config_.physics;
+  w.world.setGravity(btVector3(0, 0, -p.gravity_m_s2));
+  btContactSolverInfo& solver = w.world.getSolverInfo();
+  solver.m_numIterations = p.solver_iterations;
+  solver.m_frictionERP = p.friction_erp;
+  solver.m_leastSquaresResidualThreshold =
+      static_cast<btScalar>(p.solver_tolerance_m_s * p.solver_tolerance_m_s);
+  solver.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+
+  w.shapes.push_back(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0));
+  w.floor = std::make_unique<btRigidBody>(
+      btRigidBody::btRigidBodyConstructionInfo(0, nullptr, w.shapes.back().get()));
+  w.floor->setFriction(0.5);
+  w.world.addRigidBody(w.floor.get(), btBroadphaseProxy::StaticFilter, kObjectGroup);
+
+  // Links: kinematic compounds of their collision elements.
+  w.links.resize(description_.links.size());
+  for (size_t l = 0; l < description_.links.size(); ++l) {
+    const HandLink& link = description_.links[l];
+    if (link.collisions.empty()) continue;
+    auto compound = std::make_unique<btCompoundShape>();
+    for (const HandCollision& c : link.collisions) {
+      std::unique_ptr<btCollisionShape> shape;
+      switch (c.kind) {
+        case HandCollision::Kind::kBox: shape = std::make_unique<btBoxShape>(toBt(c.size / 2)); break;
+        case HandCollision::Kind::kCylinder:
+          shape = std::make_unique<btCylinderShapeZ>(btVector3(c.size.x(), c.size.x(), c.size.y() / 2));
+          break;
+        case HandCollision::Kind::kSphere: shape = std::make_unique<btSphereShape>(c.size.x()); break;
+        case HandCollision::Kind::kMesh: shape = bulletHull(c.mesh_vertices); break;
+      }
+      if (c.kind != HandCollision::Kind::kMesh) {
+        shape->setMargin(std::min<double>(kBoxMargin, 0.25 * c.size.head<2>().maxCoeff()));
+      }
+      compound->addChildShape(toBt(c.origin), shape.get());
+      w.shapes.push_back(std::move(shape));
+    }
+    btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, compound.get());
+    info.m_friction = config_.object.friction;
+    info.m_restitution = 0;
+    auto body = std::make_unique<btRigidBody>(info);
+    body->setCollisionFlags(body->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+    body->setActivationState(DISABLE_DEACTIVATION);
+    w.shapes.push_back(std::move(compound));
+    // A DIGIT's link meets the object through its soft gel only.
+    const bool sensor_link =
+        std::count(sensor_links_.begin(), sensor_links_.end(), static_cast<int>(l)) > 0;
+    w.world.addRigidBody(body.get(), kLinkGroup, sensor_link ? 0 : kObjectGroup);
+    w.links[l] = std::move(body);
+  }
+
+  // Gels: kinematic boxes behind each gel surface, soft-contact, with the material's friction.
+  const btVector3 gel_half(config_.gel_width_m / 2, config_.gel_height_m / 2,
+                           config_.gel_thickness_m / 2);
+  auto gel_box = std::make_unique<btBoxShape>(gel_half);
+  gel_box->setMargin(kBoxMargin);
+  btCollisionShape* gel_shape = gel_box.get();
+  w.shapes.push_back(std::move(gel_box));
+  for (size_t s = 0; s < sensor_links_.size(); ++s) {
+    btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, gel_shape);
+    info.m_friction = config_.object.friction;
+    info.m_restitution = 0;
+    auto gel = std::make_unique<btRigidBody>(info);
+    gel->setCollisionFlags(gel->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT |
+                           btCollisionObject::CF_HAS_FRICTION_ANCHOR);
+    gel->setActivationState(DISABLE_DEACTIVATION);
+    gel->setContactStiffnessAndDamping(config_.gel_law.secantStiffness(0.0), p.gel_damping);
+    w.world.addRigidBody(gel.get(), kGelGroup, 0);
+    w.gels.push_back(std::move(gel));
+  }
+
+  // Object: dynamic, its body at its bounds' centre. The hull's hollows are measured against
+  // the first gel's normal at the start.
+  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
+  Eigen::Vector3d gel_axis = Eigen::Vector3d::UnitY();
+  if (!sensor_links_.empty()) {
+    gel_axis = (config_.object_pose.linear().transpose() * gelInWorld(0).linear().col(2)).normalized();
+  }
+  ObjectCollisionShapes shapes = makeObjectCollision(
+      object_, config_.object.collision, centre, config_.gel_law.points().back().first, gel_axis);
+  w.object_shapes = std::move(shapes.shapes);
+  w.contact_parts = std::move(shapes.contact_parts);
+  w.contact_capsule = shapes.contact_capsule;
+  collision_ = shapes.collision;
+  btCollisionShape* shape = w.object_shapes.back().get();
+  btVector3 inertia(0, 0, 0);
+  shape->calculateLocalInertia(config_.object.mass_kg, inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(config_.object.mass_kg, nullptr, shape, inertia);
+  info.m_friction = 1.0;
+  info.m_restitution = 0;
+  w.object = std::make_unique<btRigidBody>(info);
+  w.object->setActivationState(DISABLE_DEACTIVATION);
+  w.object->setCollisionFlags(w.object->getCollisionFlags() |
+                              btCollisionObject::CF_HAS_FRICTION_ANCHOR);
+  w.object->setWorldTransform(toBt(config_.object_pose * object_in_body_.inverse()));
+  w.world.addRigidBody(w.object.get(), kObjectGroup, btBroadphaseProxy::StaticFilter | kLinkGroup);
+
+  const size_t parts = w.contact_capsule ? 1 : w.contact_parts.size();
+  w.manifolds.resize(sensor_links_.size());
+  for (size_t s = 0; s < sensor_links_.size(); ++s) {
+    for (size_t k = 0; k < parts; ++k) {
+      btPersistentManifold* manifold =
+          w.dispatcher.getNewManifold(w.gels[s].get(), w.object.get());
+      manifold->setContactBreakingThreshold(kContactBreakingM);
+      w.manifolds[s].push_back(manifold);
+    }
+  }
+  contacts_.assign(sensor_links_.size(), GelContactState{});
+  gel_points_.assign(sensor_links_.size(), {});
+  placeBodies();
+  for (size_t s = 0; s < sensor_links_.size(); ++s) {
+    contacts_[s].object_in_gel = gelInWorld(static_cast<int>(s)).inverse() * objectInWorld();
+  }
+}
+
+void HandSim::placeBodies() {
+  World& w = *world_;
+  for (size_t l = 0; l < w.links.size(); ++l) {
+    if (!w.links[l]) continue;
+    w.links[l]->setWorldTransform(toBt(link_poses_[l]));
+    w.links[l]->setInterpolationWorldTransform(w.links[l]->getWorldTransform());
+  }
+  for (size_t s = 0; s < w.gels.size(); ++s) {
+    // The gel box's centre sits half a thickness behind the gel surface (gel -z).
+    const Eigen::Isometry3d box = gelInWorld(static_cast<int>(s)) *
+                                  Eigen::Translation3d(0, 0, -config_.gel_thickness_m / 2);
+    w.gels[s]->setWorldTransform(toBt(box));
+    w.gels[s]->setInterpolationWorldTransform(w.gels[s]->getWorldTransform());
+  }
+}
+
+std::vector<int> HandSim::validateNames(const std::vector<std::string>& names) const {
+  std::vector<int> joints;
+  for (const std::string& name : names) {
+    const int j = description_.jointIndex(name);
+    if (j < 0) {
+      std::string valid;
+      for (const std::string& n : actuated_names_) valid += (valid.empty() ? "" : ", ") + n;
+      throw Error("unknown joint '" + name + "'; the hand's actuated joints: " + valid);
+    }
+    if (!description_.joints[j].movable()) throw Error("joint '" + name + "' is fixed");
+    if (description_.joints[j].mimic_master >= 0) {
+      throw Error("joint '" + name + "' mimics '" +
+                  description_.joints[description_.joints[j].mimic_master].name +
+                  "': command its master");
+    }
+    if (std::count(joints.begin(), joints.end(), j)) throw Error("joint '" + name + "' is named twice");
+    joints.push_back(j);
+  }
+  return joints;
+}
+
+std::vector<std::string> HandSim::setJointTargets(const std::vector<std::string>& names,
+                                                  const std::vector<double>& positions) {
+  const std::vector<int> joints = validateNames(names);
+  if (positions.size() != names.size()) {
+    throw Error("joint targets: " + std::to_string(names.size()) + " names but " +
+                std::to_string(positions.size()) + " positions");
+  }
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (!std::isfinite(positions[i])) throw Error("joint '" + names[i] + "': target is not finite");
+  }
+  std::vector<std::string> clamped_names;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    bool clamped = false;
+    target_[joints[i]] = clampToLimits(joints[i], positions[i], clamped);
+    if (clamped) clamped_names.push_back(names[i]);
+  }
+  following_trajectory_ = false;
+  return clamped_names;
+}
+
+std::vector<std::string> HandSim::setTrajectory(const JointTrajectoryCommand& t) {
+  const std::vector<int> joints = validateNames(t.joint_names);
+  if (t.times_s.empty() || t.times_s.size() != t.positions.size()) {
+    throw Error("joint trajectory: " + std::to_string(t.times_s.size()) + " times for " +
+                std::to_string(t.positions.size()) + " points (at least one point needed)");
+  }
+  double previous = 0.0;
+  for (size_t p = 0; p < t.times_s.size(); ++p) {
+    const double time = t.times_s[p];
+    if (!std::isfinite(time) || time < 0.0 || (p > 0 && time <= previous)) {
+      std::ostringstream message;
+      message << "joint trajectory: point " << p << "'s time_from_start " << time
+              << " s is not " << (time < 0.0 || !std::isfinite(time) ? "finite and >= 0" :
+                                  "after the previous point's");
+      throw Error(message.str());
+    }
+    previous = time;
+    if (t.positions[p].size() != joints.size()) {
+      throw Error("joint trajectory: point " + std::to_string(p) + " has " +
+                  std::to_string(t.positions[p].size()) + " positions for " +
+                  std::to_string(joints.size()) + " joints");
+    }
+    for (size_t i = 0; i < joints.size(); ++i) {
+      if (!std::isfinite(t.positions[p][i])) {
+        throw Error("joint trajectory: point " + std::to_string(p) + ", joint '" +
+                    t.joint_names[i] + "': position is not finite");
+      }
+    }
+  }
+  Trajectory trajectory;
+  trajectory.joints = joints;
+  trajectory.times_s = t.times_s;
+  trajectory.start_s = ticks_ * tickSeconds();
+  std::vector<std::string> clamped_names;
+  for (size_t i = 0; i < joints.size(); ++i) trajectory.start.push_back(target_[joints[i]]);
+  for (const std::vector<double>& point : t.positions) {
+    std::vector<double> clamped_point(point.size());
+    for (size_t i = 0; i < joints.size(); ++i) {
+      bool clamped = false;
+      clamped_point[i] = clampToLimits(joints[i], point[i], clamped);
+      if (clamped && !std::count(clamped_names.begin(), clamped_names.end(), t.joint_names[i])) {
+        clamped_names.push_back(t.joint_names[i]);
+      }
+    }
+    trajectory.positions.push_back(clamped_point);
+  }
+  trajectory_ = std::move(trajectory);
+  following_trajectory_ = true;
+  return clamped_names;
+}
+
+void HandSim::setOpening(double opening) {
+  const HandConfig& h = config_.hand;
+  if (h.gripper_joints.empty()) {
+    throw Error("this hand has no parallel-gripper joints (gripper.joints in its hand yaml)");
+  }
+  if (!(opening >= 0.0 && opening <= 1.0)) {
+    std::ostringstream message;
+    message << "gripper opening " << opening << " is out of range; valid: [0, 1] (0 = closed)";
+    throw Error(message.str());
+  }
+  std::vector<double> positions;
+  for (size_t i = 0; i < h.gripper_joints.size(); ++i) {
+    positions.push_back(h.gripper_closed[i] + opening * (h.gripper_open[i] - h.gripper_closed[i]));
+  }
+  setJointTargets(h.gripper_joints, positions);
+}
+
+void HandSim::setBasePose(const Eigen::Isometry3d& base_in_world) {
+  if (!isPose(base_in_world)) throw Error("base pose is not a finite rigid pose");
+  base_pose_ = base_in_world;
+}
+
+void HandSim::resetObject(const Eigen::Isometry3d& object_in_world, bool gravity) {
+  if (!isPose(object_in_world)) throw Error("object pose is not a finite rigid pose");
+  btRigidBody& object = *world_->object;
+  object.setWorldTransform(toBt(object_in_world * object_in_body_.inverse()));
+  object.setInterpolationWorldTransform(object.getWorldTransform());
+  object.setLinearVelocity(btVector3(0, 0, 0));
+  object.setAngularVelocity(btVector3(0, 0, 0));
+  object.clearForces();
+  for (auto& gel_manifolds : world_->manifolds) {
+    for (btPersistentManifold* manifold : gel_manifolds) manifold->clearManifold();
+  }
+  setObjectGravity(gravity);
+}
+
+void HandSim::setObjectGravity(bool on) {
+  world_->object->setGravity(on ? world_->world.getGravity() : btVector3(0, 0, 0));
+}
+
+void HandSim::advanceTrajectory() {
+  if (!following_trajectory_) return;
+  const Trajectory& t = trajectory_;
+  // The target at the end of the tick about to run.
+  const double now = (ticks_ + 1) * tickSeconds() - t.start_s;
+  // The segment the time is in: from the start (time 0) or the previous point to the next.
+  size_t next = 0;
+  while (next < t.times_s.size() && t.times_s[next] < now) ++next;
+  for (size_t i = 0; i < t.joints.size(); ++i) {
+    double value;
+    if (next == t.times_s.size()) {
+      value = t.positions.back()[i];
+    } else {
+      const double t0 = next == 0 ? 0.0 : t.times_s[next - 1];
+      const double p0 = next == 0 ? t.start[i] : t.positions[next - 1][i];
+      const double s = t.times_s[next] > t0 ? (now - t0) / (t.times_s[next] - t0) : 1.0;
+      value = p0 + std::clamp(s, 0.0, 1.0) * (t.positions[next][i] - p0);
+    }
+    target_[t.joints[i]] = value;
+  }
+  if (next == t.times_s.size()) following_trajectory_ = false;
+}
+
+void HandSim::moveJoints(double dt) {
+  for (int j : actuated_) {
+    const Drive& d = drives_[j];
+    // The load the drive feels: its own joint's, and its mimic joints' through their ratio.
+    double load = load_[j], k_contact = contact_stiffness_[j];
+    for (size_t m = 0; m < description_.joints.size(); ++m) {
+      const HandJoint& mimic = description_.joints[m];
+      if (mimic.mimic_master != j) continue;
+      load += mimic.mimic_multiplier * load_[m];
+      k_contact += mimic.mimic_multiplier * mimic.mimic_multiplier * contact_stiffness_[m];
+    }
+    const double max_move = d.velocity * dt;
+    double move = std::clamp(target_[j] - drive_q_[j], -max_move, max_move);
+    // A drive pushes against its load with at most its effort: it advances into the load only
+    // as far as the contact's stiffness lets the load grow to the effort, and yields where the
+    // load exceeds it (one Newton step a tick, as GripperSim's compliant drive). Against a rigid
+    // contact (no gel on the way) it stops.
+    const double into = load < 0.0 ? 1.0 : -1.0;  // the direction that pushes into the load
+    const double excess = std::abs(load) - d.effort;
+    const bool pushing = move * into > 0.0;
+    if (excess >= 0.0) {
+      const double yield =
+          k_contact > 0.0 ? std::clamp(-into * excess / k_contact, -max_move, max_move) : 0.0;
+      if (pushing || std::abs(yield) > std::abs(move)) move = yield;
+    } else if (pushing && k_contact > 0.0) {
+      move = into * std::min(std::abs(move), -excess / k_contact);
+    }
+    drive_q_[j] += move;
+    bool clamped = false;
+    drive_q_[j] = clampToLimits(j, drive_q_[j], clamped);
+    if (d.stiffness > 0.0) {
+      // In series with a spring of stiffness k: at rest q = drive + load / k.
+      const double residual = drive_q_[j] + load / d.stiffness - q_[j];
+      q_[j] += std::clamp(residual * d.stiffness / (d.stiffness + k_contact), -max_move, max_move);
+    } else {
+      q_[j] = drive_q_[j];
+    }
+  }
+  for (size_t m = 0; m < description_.joints.size(); ++m) {
+    const HandJoint& joint = description_.joints[m];
+    if (joint.mimic_master >= 0) {
+      q_[m] = joint.mimic_multiplier * q_[joint.mimic_master] + joint.mimic_offset;
+      target_[m] = joint.mimic_multiplier * target_[joint.mimic_master] + joint.mimic_offset;
+    }
+  }
+  forwardKinematics();
+  placeBodies();
+}
+
+std::vector<std::vector<GelContactPoint>> HandSim::gelPoints(int sensor) const {
+  const GelPad pad{config_.gel_width_m / 2, config_.gel_height_m / 2};
+  const Eigen::Isometry3d body_in_gel =
+      gelInWorld(sensor).inverse() * toEigen(world_->object->getWorldTransform());
+  std::vector<std::vector<GelContactPoint>> points;
+  if (world_->contact_capsule) {
+    points.push_back(gelContactPoints(*world_->contact_capsule, body_in_gel, pad));
+  } else {
+    for (const ConvexPolytope& part : world_->contact_parts) {
+      points.push_back(gelContactPoints(part, body_in_gel, pad));
+    }
+  }
+  return points;
+}
+
+void HandSim::updateGelContacts() {
+  // As GripperSim::updateGelContacts, for every mounted gel.
+  const btRigidBody& object = *world_->object;
+  const double half_w = config_.gel_width_m / 2, half_h = config_.gel_height_m / 2;
+  for (size_t i = 0; i < world_->gels.size(); ++i) {
+    const btRigidBody& gel = *world_->gels[i];
+    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<int>(i));
+    const Eigen::Isometry3d world_in_gel = gel_in_world.inverse();
+    const Eigen::Vector3d normal_on_object = -gel_in_world.linear().col(2);  // into the gel
+    gel_points_[i] = gelPoints(static_cast<int>(i));
+    for (size_t k = 0; k < gel_points_[i].size(); ++k) {
+      btPersistentManifold& manifold = *world_->manifolds[i][k];
+      manifold.refreshContactPoints(gel.getWorldTransform(), object.getWorldTransform());
+      for (int c = manifold.getNumContacts() - 1; c >= 0; --c) {
+        const Eigen::Vector3d on_object =
+            world_in_gel * toEigen(manifold.getContactPoint(c).m_positionWorldOnB);
+        if (std::abs(on_object.x()) > half_w + kContactBreakingM ||
+            std::abs(on_object.y()) > half_h + kContactBreakingM) {
+          manifold.removeContactPoint(c);
+        }
+      }
+      for (const GelContactPoint& p : spanningContactPoints(gel_points_[i][k])) {
+        const Eigen::Vector3d on_object = gel_in_world * p.position;
+        const Eigen::Vector3d on_gel =
+            gel_in_world * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
+        btManifoldPoint point(gel.getWorldTransform().invXform(toBt(on_gel)),
+                              object.getWorldTransform().invXform(toBt(on_object)),
+                              toBt(normal_on_object), static_cast<btScalar>(-p.depth));
+        point.m_positionWorldOnA = toBt(on_gel);
+        point.m_positionWorldOnB = toBt(on_object);
+        point.m_combinedFriction = static_cast<btScalar>(config_.object.friction);
+        point.m_combinedRestitution = 0;
+        point.m_contactPointFlags |= BT_CONTACT_FLAG_FRICTION_ANCHOR;
+        const int index = manifold.getCacheEntry(point);
+        if (index >= 0) {
+          manifold.replaceContactPoint(point, index);
+        } else {
+          manifold.addManifoldPoint(point);
+        }
+      }
+    }
+  }
+}
+
+void HandSim::updateGelStiffness() {
+  // As GripperSim::updateGelStiffness: the law's secant stiffness at the deepest point, shared
+  // among the points by depth; a lone point gets the patch's torsional friction.
+  const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
+  const double min_half_size = static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0;
+  for (size_t i = 0; i < world_->gels.size(); ++i) {
+    double deepest = 0.0, sum = 0.0;
+    int points = 0;
+    for (btPersistentManifold* manifold : world_->manifolds[i]) {
+      for (int c = 0; c < manifold->getNumContacts(); ++c) {
+        ++points;
+        const double d = -manifold->getContactPoint(c).getDistance();
+        if (d > 0.0) {
+          deepest = std::max(deepest, d);
+          sum += d;
+        }
+      }
+    }
+    const double k = sum > 0.0
+                         ? config_.gel_law.force(std::min(deepest, config_.gel_thickness_m)) / sum
+                         : config_.gel_law.secantStiffness(0.0);
+    world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
+    const double patch_radius = points == 1 ? std::sqrt(2.0 * min_half_size * deepest) : 0.0;
+    const btScalar spinning = static_cast<btScalar>(3.0 * M_PI / 16.0 *
+                                                    config_.object.friction * patch_radius);
+    for (btPersistentManifold* manifold : world_->manifolds[i]) {
+      for (int c = 0; c < manifold->getNumContacts(); ++c) {
+        btManifoldPoint& point = manifold->getContactPoint(c);
+        point.m_combinedContactStiffness1 = k;
+        point.m_combinedContactDamping1 = damping;
+        point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+        point.m_combinedSpinningFriction = spinning;
+        point.m_combinedRollingFriction = spinning > 0 ? btScalar(1e-9) : btScalar(0);
+      }
+    }
+  }
+}
+
+void HandSim::addLoad(int link, const Eigen::Vector3d& point, const Eigen::Vector3d& force,
+                      const Eigen::Vector3d& normal, double normal_stiffness) {
+  for (int j : link_joints_[link]) {
+    const HandJoint& joint = description_.joints[j];
+    const Eigen::Isometry3d& frame = link_poses_[joint.child_link];
+    const Eigen::Vector3d axis = frame.linear() * joint.axis;
+    // The point's motion per unit of the joint's coordinate.
+    const Eigen::Vector3d motion = joint.type == HandJoint::Type::kPrismatic
+                                       ? axis
+                                       : Eigen::Vector3d(axis.cross(point - frame.translation()));
+    load_[j] += motion.dot(force);
+    if (normal_stiffness > 0.0) {
+      const double along = motion.dot(normal);
+      contact_stiffness_[j] += normal_stiffness * along * along;
+    }
+  }
+}
+
+void HandSim::measureContacts(double dt) {
+  std::fill(load_.begin(), load_.end(), 0.0);
+  std::fill(contact_stiffness_.begin(), contact_stiffness_.end(), 0.0);
+  const Eigen::Isometry3d object_in_world = objectInWorld();
+  const double deepest_law_point = config_.gel_law.points().back().first;
+  for (size_t i = 0; i < world_->gels.size(); ++i) {
+    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<int>(i));
+    GelContactState& state = contacts_[i];
+    state = GelContactState{};
+    state.object_in_gel = gel_in_world.inverse() * object_in_world;
+    gel_points_[i] = gelPoints(static_cast<int>(i));
+    for (const std::vector<GelContactPoint>& part : gel_points_[i]) {
+      for (const GelContactPoint& p : part) state.penetration_m = std::max(state.penetration_m, p.depth);
+    }
+    state.too_deep = state.penetration_m > deepest_law_point;
+    Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
+    const Eigen::Vector3d out_of_gel = gel_in_world.linear().col(2);
+    const double k_gel = config_.gel_law.tangentStiffness(
+        std::min(state.penetration_m, config_.gel_thickness_m));
+    for (btPersistentManifold* manifold : world_->manifolds[i]) {
+      for (int c = 0; c < manifold->getNumContacts(); ++c) {
+        const btManifoldPoint& point = manifold->getContactPoint(c);
+        const double normal = point.getAppliedImpulse() / dt;
+        const Eigen::Vector3d lateral =
+            (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
+             toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
+            dt;
+        state.normal_force_n += normal;
+        shear_world += lateral;
+        // On the gel: pushed back into itself, and dragged by friction.
+        addLoad(sensor_links_[i], toEigen(point.m_positionWorldOnA), -out_of_gel * normal + lateral,
+                out_of_gel, 0.0);
+      }
+    }
+    // The gel's stiffness as the drive sees it, at the patch's centre: the law's tangent.
+    if (state.penetration_m > 0.0) addLoad(sensor_links_[i], gel_in_world.translation(),
+                                           Eigen::Vector3d::Zero(), out_of_gel, k_gel);
+    state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
+    state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
+    state.shear_force_n.z() = 0.0;
+  }
+  // Rigid links against the object: Bullet's own manifolds.
+  btDispatcher& dispatcher = world_->dispatcher;
+  const btCollisionObject* object = world_->object.get();
+  for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher.getManifoldByIndexInternal(m);
+    const bool object_is_b = manifold->getBody1() == object;
+    if (!object_is_b && manifold->getBody0() != object) continue;
+    const btCollisionObject* other = object_is_b ? manifold->getBody0() : manifold->getBody1();
+    int link = -1;
+    for (size_t l = 0; l < world_->links.size(); ++l) {
+      if (world_->links[l].get() == other) link = static_cast<int>(l);
+    }
+    if (link < 0) continue;
+    for (int c = 0; c < manifold->getNumContacts(); ++c) {
+      const btManifoldPoint& point = manifold->getContactPoint(c);
+      // The normal points from B to A; a positive impulse pushes A along it.
+      Eigen::Vector3d on_a = toEigen(point.m_normalWorldOnB) * point.getAppliedImpulse() / dt +
+                             (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
+                              toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
+                                 dt;
+      const Eigen::Vector3d on_link = object_is_b ? on_a : Eigen::Vector3d(-on_a);
+      addLoad(link, toEigen(object_is_b ? point.m_positionWorldOnA : point.m_positionWorldOnB),
+              on_link, Eigen::Vector3d::Zero(), 0.0);
+    }
+  }
+}
+
+void HandSim::step(int ticks) {
+  const int substeps = config_.physics.substeps;
+  const double dt = tickSeconds() / substeps;
+  for (int t = 0; t < ticks; ++t) {
+    advanceTrajectory();
+    for (int s = 0; s < substeps; ++s) {
+      moveJoints(dt);
+      updateGelContacts();
+      updateGelStiffness();
+      world_->world.stepSimulation(dt, 0, dt);
+      measureContacts(dt);
+    }
+    ++ticks_;
+  }
+}
+
+}  // namespace norm2tex
