@@ -11,8 +11,9 @@
 //     <rosparam param="nodelets">[{name: probe_sim, type: norm2tex/ProbeSimNodelet}]</rosparam>
 //   </node>
 // Each nodelet reads its parameters from its own private namespace (/probe_sim/...), as when
-// loaded by a client; names are resolved in the group's namespace. ~num_worker_threads as for
-// `nodelet manager`.
+// loaded by a client; names are resolved in the group's namespace. An entry's optional
+// `params: {key: value, ...}` are set in that namespace before the nodelet is loaded.
+// ~num_worker_threads as for `nodelet manager`.
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -26,6 +27,9 @@ namespace {
 
 struct NodeletSpec {
   std::string name, type;
+  /// Optional: private parameters set before the nodelet is loaded (a list made by a program,
+  /// e.g. scripts/hand_nodelets' one renderer per sensor, carries each one's parameters).
+  XmlRpc::XmlRpcValue params;
 };
 
 /// ~nodelets as a list of {name, type}; an empty list and the reason when it is malformed.
@@ -45,8 +49,16 @@ std::vector<NodeletSpec> readNodelets(const ros::NodeHandle& pnh, std::string* w
       *why = "~nodelets[" + std::to_string(i) + "] is not {name: NAME, type: PACKAGE/Type}";
       return {};
     }
-    specs.push_back(
-        {static_cast<std::string>(entry["name"]), static_cast<std::string>(entry["type"])});
+    NodeletSpec spec{static_cast<std::string>(entry["name"]),
+                     static_cast<std::string>(entry["type"]), XmlRpc::XmlRpcValue()};
+    if (entry.hasMember("params")) {
+      if (entry["params"].getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+        *why = "~nodelets[" + std::to_string(i) + "].params is not a map of parameters";
+        return {};
+      }
+      spec.params = entry["params"];
+    }
+    specs.push_back(spec);
   }
   return specs;
 }
@@ -59,7 +71,8 @@ int main(int argc, char** argv) {
       std::fputs(
           "usage: rosrun norm2tex nodelet_group [__name:=NAME]  (usually from a launch file)\n"
           "  A nodelet manager that loads the nodelets of its ~nodelets parameter itself:\n"
-          "  ~nodelets: [{name: NAME, type: PACKAGE/Type}, ...]; ~num_worker_threads as for\n"
+          "  ~nodelets: [{name: NAME, type: PACKAGE/Type[, params: {KEY: VALUE, ...}]}, ...]\n"
+          "  (params: set in the nodelet's private namespace first); ~num_worker_threads as for\n"
           "  `nodelet manager`.\n",
           stdout);
       return 0;
@@ -77,6 +90,9 @@ int main(int argc, char** argv) {
   nodelet::Loader loader(true);
   for (const NodeletSpec& spec : specs) {
     const std::string name = ros::names::resolve(spec.name);
+    if (spec.params.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+      for (auto& param : spec.params) ros::param::set(name + "/" + param.first, param.second);
+    }
     if (!loader.load(name, spec.type, nodelet::M_string(), nodelet::V_string())) {
       ROS_FATAL(
           "nodelet_group: could not load %s of type %s (is the type in a nodelet plugin "

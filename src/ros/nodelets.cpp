@@ -1,5 +1,5 @@
 // The nodes as nodelets, so one manager shares messages between the physics, the renderers and
-// the recorder without copies: norm2tex/ContactSimNodelet, norm2tex/ProbeSimNodelet,
+// the recorder without copies: norm2tex/ContactSimNodelet, norm2tex/HandSimNodelet, norm2tex/ProbeSimNodelet,
 // norm2tex/TactileRendererNodelet, norm2tex/DatasetRecorderNodelet.
 #include <memory>
 
@@ -7,6 +7,7 @@
 #include <class_loader/register_macro.hpp>
 
 #include "contact_sim.hpp"
+#include "hand_sim_ros.hpp"
 #include "dataset_recorder.hpp"
 #include "launch_end.hpp"
 #include "params.hpp"
@@ -29,6 +30,19 @@ class ContactSimNodelet : public nodelet::Nodelet {
     }
   }
   std::unique_ptr<ContactSim> sim_;
+};
+
+class HandSimNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    try {
+      sim_ = std::make_unique<HandSimRos>(getMTNodeHandle(), getMTPrivateNodeHandle());
+    } catch (const Error& e) {
+      NODELET_FATAL("hand_sim: %s", e.what());
+      ros::shutdown();
+    }
+  }
+  std::unique_ptr<HandSimRos> sim_;
 };
 
 class TactileRendererNodelet : public nodelet::Nodelet {
@@ -105,6 +119,7 @@ class DatasetRecorderNodelet : public nodelet::Nodelet {
 
 // Debian ships ROS 1 nodelet on class_loader; pluginlib's export macro expands to this.
 CLASS_LOADER_REGISTER_CLASS(norm2tex::ContactSimNodelet, nodelet::Nodelet)
+CLASS_LOADER_REGISTER_CLASS(norm2tex::HandSimNodelet, nodelet::Nodelet)
 CLASS_LOADER_REGISTER_CLASS(norm2tex::TactileRendererNodelet, nodelet::Nodelet)
 CLASS_LOADER_REGISTER_CLASS(norm2tex::ProbeSimNodelet, nodelet::Nodelet)
 CLASS_LOADER_REGISTER_CLASS(norm2tex::DatasetRecorderNodelet, nodelet::Nodelet)

@@ -113,6 +113,11 @@ class HandSim {
   void setBasePose(const Eigen::Isometry3d& base_in_world);
   Eigen::Isometry3d basePose() const { return base_pose_; }
 
+  /// Starts again: every joint, drive and target at its initial position (no trajectory), the
+  /// root at hand.base_pose, the object at rest at `object_in_world` (config.object_pose when
+  /// null), the world rebuilt. Simulated time keeps running. Throws Error for a pose that is
+  /// not finite or not a rotation (nothing changed).
+  void reset(const Eigen::Isometry3d* object_in_world = nullptr);
   /// Puts the object at `object_in_world` at rest (with gravity on or off for it).
   void resetObject(const Eigen::Isometry3d& object_in_world, bool gravity = true);
   void setObjectGravity(bool on);
@@ -179,6 +184,7 @@ class HandSim {
   /// Per joint: the position, the drive's position, the target, the contacts' load and their
   /// stiffness in the joint's coordinate.
   std::vector<double> q_, drive_q_, target_, load_, contact_stiffness_;
+  std::vector<double> initial_q_;
   std::vector<Eigen::Isometry3d> link_poses_;
   /// Per link: the joints from the root to it (movable only).
   std::vector<std::vector<int>> link_joints_;

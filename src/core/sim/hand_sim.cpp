@@ -135,6 +135,7 @@ HandSim::HandSim(const HandSimConfig& config) : config_(config) {
       q_[j] = joint.mimic_multiplier * q_[joint.mimic_master] + joint.mimic_offset;
     }
   }
+  initial_q_ = q_;
   drive_q_ = q_;
   target_ = q_;
   // The movable joints from the root to each link.
@@ -527,6 +528,20 @@ void HandSim::resetObject(const Eigen::Isometry3d& object_in_world, bool gravity
     for (btPersistentManifold* manifold : gel_manifolds) manifold->clearManifold();
   }
   setObjectGravity(gravity);
+}
+
+void HandSim::reset(const Eigen::Isometry3d* object_in_world) {
+  if (object_in_world && !isPose(*object_in_world)) throw Error("object pose is not a finite rigid pose");
+  if (object_in_world) config_.object_pose = *object_in_world;
+  q_ = initial_q_;
+  drive_q_ = q_;
+  target_ = q_;
+  std::fill(load_.begin(), load_.end(), 0.0);
+  std::fill(contact_stiffness_.begin(), contact_stiffness_.end(), 0.0);
+  following_trajectory_ = false;
+  base_pose_ = config_.hand.base_pose;
+  forwardKinematics();
+  buildWorld();
 }
 
 void HandSim::setObjectGravity(bool on) {
