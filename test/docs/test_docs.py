@@ -10,7 +10,12 @@
   - the parameter tables of docs/ros.md ("private parameter" tables under a node's heading) list
     exactly the private parameters the node's code reads (readParam / pnh.param / getParam in src/ros/), and
     the launch-argument tables ("launch arg" tables under a launch file's heading) exactly the
-    arguments the launch file takes.
+    arguments the launch file takes;
+  - one home per headline figure: docs/performance.md's "headline figure" table names each
+    (`key` | value | provenance); a page quotes one as
+    `<!-- figure: key -->value<!-- /figure -->`, and every quote must name a key of that table
+    and carry exactly its value (whitespace aside). performance.md itself quotes every key in
+    the section that measured it, so the table cannot drift from its own measurements.
 
 Usage: test_docs.py [PACKAGE_ROOT]   (default: two folders up). Stdlib only.
 """
@@ -338,6 +343,73 @@ def documented_stop_reasons(text):
     return [set(_ticked(m.group(1))) for m in _STOP_LIST.finditer(text)]
 
 
+# --- headline figures: one home, quoted elsewhere -------------------------------------------
+HOME_PAGE = os.path.join("docs", "performance.md")
+_QUOTE = re.compile(r"<!--\s*figure:\s*([\w.-]*)\s*-->(.*?)<!--\s*/figure\s*-->", re.S)
+_OPEN = re.compile(r"<!--\s*figure:")
+_CLOSE = re.compile(r"<!--\s*/figure\s*-->")
+
+
+def _norm(value):
+    return " ".join(value.split())
+
+
+def headline_figures(home_text):
+    """({key: value} of the "headline figure" table, [problems]) of docs/performance.md."""
+    figures, problems = {}, []
+    for _, header, rows in tables(home_text):
+        if not header or header[0].lower() != "headline figure":
+            continue
+        for row in rows:
+            keys = _ticked(row[0])
+            if len(keys) != 1 or len(row) < 2 or not row[1].strip():
+                problems.append("headline figure row without one `key` and a value: %s" % row)
+                continue
+            if keys[0] in figures:
+                problems.append("headline figure '%s' is in the table twice" % keys[0])
+            figures[keys[0]] = _norm(row[1])
+    return figures, problems
+
+
+def figure_quotes(text):
+    """([(key, quoted value)], [problems]) of a page's `<!-- figure: key -->value<!-- /figure -->`
+    quotes (outside code); an opening marker without its closing one is a problem."""
+    prose = split_code(text)[0]
+    quotes = [(m.group(1), _norm(m.group(2))) for m in _QUOTE.finditer(prose)]
+    problems = []
+    rest = _QUOTE.sub("", prose)
+    if _OPEN.search(rest) or _CLOSE.search(rest):
+        problems.append("a figure marker without its pair (<!-- figure: key -->value"
+                        "<!-- /figure -->, on one page, outside code)")
+    for key, value in quotes:
+        if _OPEN.search(value):
+            problems.append("figure '%s': a quote inside a quote" % key)
+    return quotes, problems
+
+
+def check_figures(page_list, home_text, root=ROOT):
+    """Every quote names a headline figure and equals it; the home page quotes each in its body."""
+    figures, errors = headline_figures(home_text)
+    if not figures:
+        return errors + ["%s has no \"headline figure\" table" % HOME_PAGE]
+    for path, text in page_list:
+        where = os.path.relpath(path, root)
+        quotes, problems = figure_quotes(text)
+        errors += ["%s: %s" % (where, p) for p in problems]
+        for key, value in quotes:
+            if key not in figures:
+                errors.append("%s: quotes figure '%s', which is not a headline figure of %s" %
+                              (where, key, HOME_PAGE))
+            elif value != figures[key]:
+                errors.append("%s: quotes figure '%s' as '%s' where %s has '%s'" %
+                              (where, key, value, HOME_PAGE, figures[key]))
+    measured = {key for key, _ in figure_quotes(home_text)[0]}
+    for key in sorted(set(figures) - measured):
+        errors.append("%s: headline figure '%s' is not quoted in the section that measured it" %
+                      (HOME_PAGE, key))
+    return errors
+
+
 # --- the checks over a package ------------------------------------------------------------------
 def check_package(root=ROOT, page_list=None):
     """Every problem found, as one-line messages."""
@@ -384,6 +456,9 @@ def check_package(root=ROOT, page_list=None):
             for f in unowned:
                 errors.append("src/ros/%s reads private parameters of a node the docs check "
                               "does not know (add it to NODE_SOURCES)" % f)
+    home = os.path.join(root, HOME_PAGE)
+    if os.path.exists(home):
+        errors += check_figures(page_list, read(home), root)
     return errors
 
 
@@ -472,6 +547,33 @@ class CheckerCatchesBrokenPages(unittest.TestCase):
                              "`signal`, `error`, `disk_full`)\n")
         self.assertTrue(any("'signal' is documented but not in the code" in e for e in errors))
         self.assertTrue(any("'shutdown' is in the code but not documented" in e for e in errors))
+
+    def test_figure_drift(self):
+        home = read(os.path.join(ROOT, HOME_PAGE))
+        figures, _ = headline_figures(home)
+        self.assertIn("render_held_cube", figures)
+        right = "<!-- figure: render_held_cube -->%s<!-- /figure -->" % figures["render_held_cube"]
+        self.assertEqual(self.broken("A frame: **%s**.\n" % right), [])
+        self.assertEqual(self.broken("| a | %s |\n" % right.replace(" ms", "\n ms")), [])
+        drifted = "A frame: <!-- figure: render_held_cube -->1.42–1.49 ms<!-- /figure -->.\n"
+        errors = self.broken(drifted)
+        self.assertEqual(len(errors), 1, errors)
+        self.assertIn("quotes figure 'render_held_cube' as '1.42–1.49 ms'", errors[0])
+        self.assertEqual(len(self.broken("<!-- figure: no_such_key -->1 ms<!-- /figure -->\n")), 1)
+        self.assertEqual(len(self.broken("<!-- figure: render_held_cube -->1.45 ms\n")), 1)
+        self.assertEqual(self.broken("```\n<!-- figure: x -->1 ms\n```\n"), [])
+
+    def test_home_table_drift(self):
+        home = ("| headline figure | value | from |\n|---|---|---|\n"
+                "| `a` | 1 ms | here |\n| `b` | 2 ms | here |\n\n"
+                "measured: <!-- figure: a -->1 ms<!-- /figure -->, "
+                "<!-- figure: b -->3 ms<!-- /figure -->\n")
+        path = os.path.join(ROOT, HOME_PAGE)
+        errors = check_figures([(path, home)], home)
+        self.assertEqual(len(errors), 1, errors)
+        self.assertIn("'b' as '3 ms'", errors[0])
+        self.assertEqual(len(check_figures([], "| headline figure | value |\n|---|---|\n"
+                                           "| `a` | 1 ms |\n")), 1)  # not measured in the body
 
     def test_code_reads_are_found(self):
         src = ('pnh.param<std::string>("a", x, "d");\n  pnh.param("b", y, 1);\n'
