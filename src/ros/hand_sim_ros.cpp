@@ -12,6 +12,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "conversions.hpp"
+#include "markers.hpp"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
@@ -139,6 +140,8 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
   for (int s = 0; s < sim_->sensorCount(); ++s) {
     contact_pubs_.push_back(nh_.advertise<TactileContact>(sim_->sensor(s).name + "/contact", 10));
   }
+  object_marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);
+  object_marker_pub_.publish(ros_conversions::objectMarker(sim_->object().mesh, ros::Time(0)));
   publishStaticTransforms();
   lock_step_ = std::make_unique<LockStep>(
       private_nh_, params_.synchronous ? params_.renderers : std::vector<std::string>(),

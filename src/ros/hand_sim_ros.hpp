@@ -89,7 +89,7 @@ class HandSimRos {
   std::mutex mutex_;
   ros::CallbackQueue service_queue_;
   ros::NodeHandle nh_, private_nh_;
-  ros::Publisher tf_pub_, clock_pub_, joints_pub_, frame_pub_;
+  ros::Publisher tf_pub_, clock_pub_, joints_pub_, frame_pub_, object_marker_pub_;
   std::vector<ros::Publisher> contact_pubs_;
   std::unique_ptr<tf2_ros::StaticTransformBroadcaster> static_tf_;
   ros::Subscriber trajectory_sub_, targets_sub_, base_sub_, gripper_sub_;

@@ -31,6 +31,7 @@ ROOT = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else
 # Which sources hold each node's parameter reads (the node's own reader and what it calls).
 NODE_SOURCES = {
     "contact_sim": ["contact_sim.cpp"],
+    "hand_sim": ["hand_sim_ros.cpp"],
     "tactile_renderer": ["tactile_renderer_ros.cpp"],
     "probe_sim": ["probe_sim.cpp"],
     "dataset_recorder": ["dataset_recorder.cpp", "nodelets.cpp"],
@@ -485,7 +486,7 @@ class DocsTest(unittest.TestCase):
         ros_md = read(os.path.join(ROOT, "docs", "ros.md"))
         self.assertEqual(set(documented_params(ros_md)), set(NODE_SOURCES))
         self.assertEqual(set(documented_launch_args(ros_md)),
-                         {"gripper_sim.launch", "record_dataset.launch"})
+                         {"gripper_sim.launch", "hand_sim.launch", "record_dataset.launch"})
 
 
 class CheckerCatchesBrokenPages(unittest.TestCase):

@@ -108,6 +108,41 @@ TEST(LaunchFailure, AMissingFileEndsTheLaunchAtOnceWithTheReason) {
       << map_run.output;
 }
 
+TEST(LaunchFailure, ABadHandEndsHandSimLaunchWithTheReason) {
+  // An unreadable hand yaml stops roslaunch while it reads the file (scripts/hand_nodelets);
+  // what only the simulation finds (a sensor on a link the URDF lacks, a malformed URDF) ends it
+  // through the required manager, with hand_sim's FATAL naming it.
+  const std::string robots = std::string(NORM2TEX_SOURCE_DIR) + "/test/fixtures/robots/wsg50";
+  const std::string missing = (scratch() / "no_such_hand.yaml").string();
+  const LaunchRun run = launch("hand_sim.launch hand:=" + missing);
+  EXPECT_NE(run.status, 0) << run.output;
+  EXPECT_LT(run.seconds, kEndsBySelfSeconds) << run.output;
+  EXPECT_NE(run.output.find("hand_nodelets: hand yaml '" + missing + "'"), std::string::npos)
+      << run.output;
+
+  const fs::path link = scratch() / "bad_link.yaml";
+  std::ofstream(link) << "hand: {urdf: " << robots << "/wsg50_digit.urdf, package_paths: {wsg50: "
+                      << robots << "}}\nsensors: [{name: digit_left, link: finger_left_tipp}]\n";
+  const LaunchRun link_run = launch("hand_sim.launch mode:=synchronous hand:=" + link.string());
+  EXPECT_LT(link_run.seconds, kEndsBySelfSeconds) << link_run.output;
+  EXPECT_NE(link_run.output.find("sensor 'digit_left': link 'finger_left_tipp' is not in the hand"),
+            std::string::npos)
+      << link_run.output;
+  EXPECT_NE(link_run.output.find("REQUIRED process [norm2tex_manager"), std::string::npos)
+      << link_run.output;
+
+  const fs::path urdf = scratch() / "broken.urdf";
+  std::ofstream(urdf) << "<robot name=\"r\">\n<link name=\"a\">\n</robot>\n";
+  const fs::path broken = scratch() / "broken_urdf.yaml";
+  std::ofstream(broken) << "hand: {urdf: " << urdf.string() << "}\nsensors: [{name: d, link: a}]\n";
+  const LaunchRun urdf_run = launch("hand_sim.launch nodelets:=false hand:=" + broken.string());
+  EXPECT_LT(urdf_run.seconds, kEndsBySelfSeconds) << urdf_run.output;
+  EXPECT_NE(urdf_run.output.find(urdf.string() + ":"), std::string::npos) << urdf_run.output;
+  EXPECT_NE(urdf_run.output.find("not well-formed XML"), std::string::npos) << urdf_run.output;
+  EXPECT_NE(urdf_run.output.find("REQUIRED process [hand_sim"), std::string::npos)
+      << urdf_run.output;
+}
+
 TEST(LaunchFailure, ANodeletThatFailsAtStartUpEndsTheLaunchWithoutWaitingForTheOthers) {
   // A mistake only the recorder sees (its compression), loaded after probe_sim, which waits
   // for its renderers: the manager used to sit out probe_sim's ~ready_timeout (60 s) first.

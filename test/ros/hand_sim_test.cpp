@@ -1,0 +1,125 @@
+// rostest of hand_sim.launch with a real master (hand_sim.test: TACTO's WSG-50 over a cube,
+// synchronous): lock-step images per sensor, a grasp by JointTrajectory, the robot's state as
+// a simulator publishes it, refusals. Waits on conditions with deadlines, never sleeps.
+#include <map>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/JointState.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+#include <trajectory_msgs/JointTrajectory.h>
+
+#include "norm2tex/HandReset.h"
+#include "norm2tex/HandStep.h"
+#include "wait_for.hpp"
+
+namespace {
+
+using norm2tex::waitFor;
+
+struct Hand {
+  ros::NodeHandle nh;
+  tf2_ros::Buffer buffer{ros::Duration(30.0)};
+  tf2_ros::TransformListener tf{buffer, nh};
+  std::map<std::string, int> images;
+  sensor_msgs::JointState::ConstPtr joints;
+  ros::Subscriber left = nh.subscribe<sensor_msgs::Image>(
+      "/digit_left/image_raw", 1000, [this](const auto&) { ++images["digit_left"]; });
+  ros::Subscriber right = nh.subscribe<sensor_msgs::Image>(
+      "/digit_right/image_raw", 1000, [this](const auto&) { ++images["digit_right"]; });
+  ros::Subscriber joint_sub = nh.subscribe<sensor_msgs::JointState>(
+      "/joint_states", 10, [this](const auto& m) { joints = m; });
+  ros::Publisher trajectory = nh.advertise<trajectory_msgs::JointTrajectory>("/hand_sim/joint_command", 1);
+  ros::ServiceClient step = nh.serviceClient<norm2tex::HandStep>("/hand_sim/step");
+  ros::ServiceClient reset = nh.serviceClient<norm2tex::HandReset>("/hand_sim/reset");
+
+  Hand() {
+    // The renderers bake the wood texture first: the services come once hand_sim is up.
+    EXPECT_TRUE(step.waitForExistence(ros::Duration(120.0)));
+    EXPECT_TRUE(waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60.0));
+  }
+  norm2tex::HandStep::Response stepFrames(unsigned frames) {
+    norm2tex::HandStep srv;
+    srv.request.frames = frames;
+    EXPECT_TRUE(step.call(srv));
+    EXPECT_TRUE(srv.response.success) << srv.response.message;
+    return srv.response;
+  }
+  void send(const trajectory_msgs::JointTrajectory& t) {
+    ASSERT_TRUE(waitFor([&] { return trajectory.getNumSubscribers() > 0; }, 30.0));
+    trajectory.publish(t);
+  }
+};
+
+trajectory_msgs::JointTrajectory closing(double left, double right, double seconds) {
+  trajectory_msgs::JointTrajectory t;
+  t.joint_names = {"base_joint_gripper_left", "base_joint_gripper_right"};
+  trajectory_msgs::JointTrajectoryPoint point;
+  point.positions = {left, right};
+  point.time_from_start = ros::Duration(seconds);
+  t.points.push_back(point);
+  return t;
+}
+
+TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajectory) {
+  Hand hand;
+  // The simulator's robot: its description, every link on TF, the gels on their links.
+  std::string description;
+  ASSERT_TRUE(hand.nh.getParam("/robot_description", description));
+  EXPECT_NE(description.find("<robot name=\"wsg50_digit\">"), std::string::npos);
+
+  const auto first = hand.stepFrames(30);
+  EXPECT_EQ(first.missing_images, 0u);
+  // Each ~step returns once every image of its frames is out: exactly 30 per sensor.
+  ASSERT_TRUE(waitFor([&] { return hand.images["digit_left"] >= 30 && hand.images["digit_right"] >= 30; }, 10.0));
+  EXPECT_EQ(hand.images["digit_left"], 30);
+  EXPECT_EQ(hand.images["digit_right"], 30);
+  ASSERT_EQ(first.sensors, (std::vector<std::string>{"digit_left", "digit_right"}));
+  EXPECT_FALSE(first.in_contact[0] || first.in_contact[1]);
+  EXPECT_TRUE(hand.buffer.canTransform("world", "digit_left_gel", first.stamp, ros::Duration(5.0)));
+  EXPECT_TRUE(hand.buffer.canTransform("finger_right_tip", "digit_right_gel", ros::Time(0), ros::Duration(5.0)));
+  ASSERT_TRUE(waitFor([&] { return hand.joints != nullptr; }, 5.0));
+  EXPECT_EQ(hand.joints->name.size(), 2u);
+
+  // Close both fingers past the cube within 2 s: each drive stops at its 10 N effort.
+  hand.send(closing(-0.016, 0.016, 2.0));
+  const auto held = hand.stepFrames(150);
+  EXPECT_TRUE(held.in_contact[0] && held.in_contact[1]);
+  EXPECT_NEAR(held.normal_force[0], 10.0, 0.5);
+  EXPECT_NEAR(held.normal_force[1], 10.0, 0.5);
+  EXPECT_GT(held.penetration[0], 0.5e-3);
+  ASSERT_TRUE(waitFor([&] { return hand.images["digit_left"] == 180 && hand.images["digit_right"] == 180; }, 10.0));
+  // The gel frame sees the cube's face at the indentation the physics reports.
+  const geometry_msgs::TransformStamped cube =
+      hand.buffer.lookupTransform("digit_left_gel", "object", held.stamp, ros::Duration(5.0));
+  EXPECT_NEAR(cube.transform.translation.z, 0.015 - held.penetration[0], 0.2e-3);
+
+  // Refused with the reason and nothing changed: an unknown joint; then a reset opens the hand.
+  trajectory_msgs::JointTrajectory wrong = closing(-0.05, 0.05, 0.5);
+  wrong.joint_names[1] = "thumb";
+  hand.send(wrong);
+  const auto still = hand.stepFrames(30);
+  EXPECT_NEAR(still.normal_force[0], 10.0, 0.5);
+  norm2tex::HandReset reset;
+  ASSERT_TRUE(hand.reset.call(reset));
+  EXPECT_TRUE(reset.response.success) << reset.response.message;
+  const auto open = hand.stepFrames(1);
+  EXPECT_FALSE(open.in_contact[0] || open.in_contact[1]);
+  norm2tex::HandStep zero;
+  zero.request.frames = 0;
+  ASSERT_TRUE(hand.step.call(zero));
+  EXPECT_FALSE(zero.response.success);
+  EXPECT_NE(zero.response.message.find("frames = 0 refused"), std::string::npos);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "hand_sim_test");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
