@@ -427,5 +427,44 @@ TEST(HandSimGrasp, Wsg50HoldsASixtyMillimetreCylinder) {
   expectHeldThenDropped(sim, (0.050 - 0.016) / (0.055 - 0.016), 0.020);
 }
 
+TEST(HandSimGrasp, AllegroClosesFourFingersOnASphereInItsPalmByATrajectory) {
+  // Palm up (its +x, the palm's normal, along world +z), a 90 mm ball of 0.1 kg resting on the
+  // palm; every finger flexes 1.3 rad per joint and the thumb turns in, within 2 s. Each drive
+  // pushes with at most 0.7 N m: a fingertip 3-7 cm from its joints presses with 10-23 N.
+  HandSimConfig config;
+  config.hand = loadHandConfig(kAllegroYaml);
+  config.hand.base_pose = poseFromXyzRpy({0.0, 0.0, 0.1, 0.0, -M_PI / 2, 0.0});
+  config.object.mesh = "sphere:45";
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.03, 0.0, 0.17));
+  HandSim sim(config);
+  sim.step(500);  // the ball settles on the palm
+  EXPECT_NEAR(sim.objectInWorld().translation().z(), 0.1 + 0.0111 + 0.045, 1e-3);
+  JointTrajectoryCommand close;
+  close.joint_names = {"joint_1.0", "joint_2.0", "joint_3.0", "joint_5.0", "joint_6.0",
+                       "joint_7.0", "joint_9.0", "joint_10.0", "joint_11.0", "joint_12.0",
+                       "joint_13.0", "joint_14.0", "joint_15.0"};
+  close.times_s = {2.0};
+  close.positions = {{1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.39, 1.15, 1.15, 1.15}};
+  EXPECT_TRUE(sim.setTrajectory(close).empty());
+  sim.step(3000);  // closed at 2 s, then 1 s for the contacts to settle
+  const Eigen::Vector3d held = sim.objectInWorld().translation();
+  sim.step(5000);  // 5 s
+  const Eigen::Vector3d later = sim.objectInWorld().translation();
+  int touching = 0;
+  for (int s = 0; s < 4; ++s) {
+    std::printf("%s: %s %.2f N, %.3f mm\n", sim.sensor(s).name.c_str(),
+                sim.contact(s).in_contact ? "in contact" : "free", sim.contact(s).normal_force_n,
+                sim.contact(s).penetration_m * 1e3);
+    if (!sim.contact(s).in_contact) continue;
+    ++touching;
+    EXPECT_GT(sim.contact(s).normal_force_n, 2.0) << sim.sensor(s).name;
+    EXPECT_LT(sim.contact(s).normal_force_n, 30.0) << sim.sensor(s).name;
+    EXPECT_FALSE(sim.contact(s).too_deep) << sim.sensor(s).name;
+  }
+  EXPECT_GE(touching, 3);
+  std::printf("ball moved %.1f um over 5 s\n", (later - held).norm() * 1e6);
+  EXPECT_LT((later - held).norm(), 1e-3);
+}
+
 }  // namespace
 }  // namespace norm2tex

@@ -1,6 +1,8 @@
 // Physics cost of HandSim (one core) on the hands the tests load (TACTO's WSG-50 and Allegro
 // with DIGITs, test/fixtures/robots of the source tree): a tick holding the 30 mm cube at 1 mm
-// on both gels, and a tick of the Allegro's 16 joints and 4 gels moving with nothing touched.
+// on both gels, the Allegro's 16 joints and 4 gels moving with nothing touched, and the Allegro
+// holding a ball in its palm with its four DIGITs.
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -54,5 +56,32 @@ void BM_HandSim_Tick_AllegroMovingFree(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_HandSim_Tick_AllegroMovingFree)->Unit(benchmark::kMicrosecond);
+
+void BM_HandSim_Tick_AllegroHoldingSphere(benchmark::State& state) {
+  if (!fixturesThere(state)) return;
+  // hand_sim_test's grasp: palm up, a 90 mm ball in the palm, four DIGITs pressing on it.
+  norm2tex::HandSimConfig config;
+  config.hand = norm2tex::loadHandConfig(kRobots + "/allegro_hand_description/allegro_hand.yaml");
+  config.hand.base_pose = norm2tex::poseFromXyzRpy({0.0, 0.0, 0.1, 0.0, -M_PI / 2, 0.0});
+  config.object.mesh = "sphere:45";
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.03, 0.0, 0.17));
+  norm2tex::HandSim sim(config);
+  sim.step(500);
+  norm2tex::JointTrajectoryCommand close;
+  close.joint_names = {"joint_1.0", "joint_2.0", "joint_3.0", "joint_5.0", "joint_6.0",
+                       "joint_7.0", "joint_9.0", "joint_10.0", "joint_11.0", "joint_12.0",
+                       "joint_13.0", "joint_14.0", "joint_15.0"};
+  close.times_s = {2.0};
+  close.positions = {{1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.39, 1.15, 1.15, 1.15}};
+  sim.setTrajectory(close);
+  sim.step(3000);
+  for (auto _ : state) sim.step(1);
+  int touching = 0;
+  for (int s = 0; s < sim.sensorCount(); ++s) touching += sim.contact(s).in_contact;
+  state.counters["ticks/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["gels_touching"] = touching;
+}
+BENCHMARK(BM_HandSim_Tick_AllegroHoldingSphere)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
