@@ -11,6 +11,8 @@
 
 #include "norm2tex/sim/hand_config.hpp"
 #include "norm2tex/sim/hand_description.hpp"
+#include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/sim/hand_sim.hpp"
 #include "test_helpers.hpp"
 
@@ -464,6 +466,54 @@ TEST(HandSimGrasp, AllegroClosesFourFingersOnASphereInItsPalmByATrajectory) {
   EXPECT_GE(touching, 3);
   std::printf("ball moved %.1f um over 5 s\n", (later - held).norm() * 1e6);
   EXPECT_LT((later - held).norm(), 1e-3);
+}
+
+TEST(HandSimGrasp, TheBuiltInGripperAsAUrdfHoldsTheCubeAsGripperSimDoes) {
+  // config/hands/parallel_gripper.yaml against GripperSim on the same scene (config/scenes/
+  // cube.yaml): both grasp the cube at 1 mm on each gel, hold it without drift, drop it opened.
+  const std::string source = NORM2TEX_SOURCE_DIR;
+  GripperSimConfig scene = loadGripperSimConfig(source + "/config/scenes/cube.yaml");
+  setGelFromSensor(makeDigitSensorModel(), scene);
+  GripperSim gripper(scene);
+  gripper.reset(1, 0.0);
+  const Eigen::Isometry3d gripper_held = gripper.objectInWorld();
+  gripper.step(10000);
+
+  HandSimConfig config = makeHandSimConfig(source + "/config/hands/parallel_gripper.yaml", scene);
+  // The coupled drive carries both gels: twice the force that indents one by 1 mm.
+  config.hand.drives["finger_left_joint"].effort = 2.0 * scene.gel_law.force(1e-3);
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 0.2));
+  HandSim hand(config);
+  EXPECT_TRUE((hand.gelInWorld(0).linear() - gripper.gelInWorld(Finger::kLeft).linear()).isZero(1e-12));
+  EXPECT_TRUE((hand.gelInWorld(1).linear() - gripper.gelInWorld(Finger::kRight).linear()).isZero(1e-12));
+  EXPECT_NEAR(hand.gelInWorld(0).translation().y(), 0.020, 1e-12);
+  hand.resetObject(config.object_pose, false);
+  hand.setOpening(0.0);
+  hand.step(1500);
+  hand.setObjectGravity(true);
+  hand.step(500);
+  for (int s = 0; s < 2; ++s) {
+    const Finger finger = static_cast<Finger>(s);
+    EXPECT_NEAR(gripper.contact(finger).penetration_m, 1e-3, 3e-6);
+    EXPECT_NEAR(hand.contact(s).penetration_m, 1e-3, 3e-6) << hand.sensor(s).name;
+    EXPECT_NEAR(hand.contact(s).normal_force_n, gripper.contact(finger).normal_force_n,
+                0.01 * gripper.contact(finger).normal_force_n);
+  }
+  // The cube hangs in the gels as deep in both: its weight shears them the same way.
+  const Eigen::Isometry3d held = hand.objectInWorld();
+  EXPECT_NEAR(held.translation().z(), gripper_held.translation().z(), 0.05e-3);
+  hand.step(10000);
+  const double hand_drift = (hand.objectInWorld().translation() - held.translation()).norm();
+  const double gripper_drift =
+      (gripper.objectInWorld().translation() - gripper_held.translation()).norm();
+  std::printf("10 s drift: built-in as URDF %.3f um, GripperSim %.3f um\n", hand_drift * 1e6,
+              gripper_drift * 1e6);
+  EXPECT_LT(hand_drift, 1e-6);
+  EXPECT_LT(gripper_drift, 1e-6);
+  hand.setOpening(1.0);
+  hand.step(1500);
+  EXPECT_FALSE(hand.contact(0).in_contact || hand.contact(1).in_contact);
+  EXPECT_LT(hand.objectInWorld().translation().z(), 0.2 - 0.0128);  // below the gel pads
 }
 
 }  // namespace
