@@ -124,7 +124,7 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   if (!owns_clock_) time_base_ = ros::Time::now();
   // As Gazebo does: the simulator is the source of the robot's description.
-  nh_.setParam("robot_description", sim_->description().urdf_xml);
+  nh_.setParam("robot_description", sim_->description().resolved_urdf_xml);
   {
     // For clients: the sensors in the yaml's order and the joints a command may name.
     std::vector<std::string> sensors;

@@ -80,6 +80,11 @@ TEST(HandDescription, LoadsTactosWsg50AsItIsWithAWordOnWhatItChanged) {
     EXPECT_LT(link.inertia.maxCoeff(), 1e-2) << link.name;
   }
   EXPECT_NE(hand.urdf_xml.find("<robot name=\"wsg50_digit\">"), std::string::npos);
+  // For /robot_description: every mesh as an absolute file:// URI, nothing else changed.
+  EXPECT_EQ(hand.resolved_urdf_xml.find("package://"), std::string::npos);
+  EXPECT_NE(hand.resolved_urdf_xml.find("filename=\"file://" + kRobots + "/wsg50/DIGIT-WSG-50-V1.STL\""),
+            std::string::npos);
+  EXPECT_NE(hand.resolved_urdf_xml.find("<limit lower=\"-0.055\" upper=\"-0.0027\""), std::string::npos);
 }
 
 TEST(HandDescription, APlausibleInertiaIsKept) {

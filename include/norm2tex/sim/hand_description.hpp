@@ -67,8 +67,11 @@ struct HandDescription {
   /// What loading changed or ignored (duplicated tags, replaced inertias, left-out links), one
   /// line each, for the user to read.
   std::vector<std::string> warnings;
-  /// The URDF text as read (what /robot_description publishes).
+  /// The URDF text as read.
   std::string urdf_xml;
+  /// The same with every mesh file name resolved to an absolute `file://` URI (what
+  /// /robot_description carries: rviz finds the meshes without the hand yaml's package_paths).
+  std::string resolved_urdf_xml;
 
   /// Index of a link or joint by name, -1 when absent.
   int linkIndex(const std::string& name) const;

@@ -294,6 +294,29 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
   const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
   if (!robot) throw Error(urdf_path + ": not a URDF (no <robot> element)");
   warnDuplicatedTags(*robot, urdf_path, hand.warnings);
+  {
+    // Visual and collision meshes alike: a URI that cannot be resolved is left as it is (a
+    // visual mesh the simulation does not need; a collision mesh fails below with the reason).
+    tinyxml2::XMLDocument resolved;
+    resolved.Parse(hand.urdf_xml.c_str(), hand.urdf_xml.size());
+    std::function<void(tinyxml2::XMLElement*)> visit = [&](tinyxml2::XMLElement* element) {
+      for (tinyxml2::XMLElement* child = element->FirstChildElement(); child;
+           child = child->NextSiblingElement()) {
+        const char* filename = child->Attribute("filename");
+        if (std::string(child->Name()) == "mesh" && filename) {
+          try {
+            child->SetAttribute("filename", ("file://" + resolveUri(filename, base_dir, paths)).c_str());
+          } catch (const Error&) {
+          }
+        }
+        visit(child);
+      }
+    };
+    visit(resolved.RootElement());
+    tinyxml2::XMLPrinter printer;
+    resolved.Print(&printer);
+    hand.resolved_urdf_xml = printer.CStr();
+  }
 
   CollectErrors errors;
   console_bridge::useOutputHandler(&errors);
