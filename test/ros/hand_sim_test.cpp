@@ -1,6 +1,8 @@
 // rostest of hand_sim.launch with a real master (hand_sim.test: TACTO's WSG-50 over a cube,
 // synchronous): lock-step images per sensor, a grasp by JointTrajectory, the robot's state as
 // a simulator publishes it, refusals. Waits on conditions with deadlines, never sleeps.
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -62,6 +64,42 @@ trajectory_msgs::JointTrajectory closing(double left, double right, double secon
   point.time_from_start = ros::Duration(seconds);
   t.points.push_back(point);
   return t;
+}
+
+TEST(HandSimRealTime, FourSensorsPublishAnImageOfEveryFrameAtSixtyHertz) {
+  // Real time: the stamps of each sensor's images must be the frames' grid, 1/60 s apart, with
+  // none missing, for two seconds of frames (counted, not timed).
+  ros::NodeHandle nh;
+  const std::vector<std::string> sensors = {"digit_index", "digit_middle", "digit_ring", "digit_thumb"};
+  std::map<std::string, std::vector<ros::Time>> stamps;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string& sensor : sensors) {
+    subs.push_back(nh.subscribe<sensor_msgs::Image>(
+        "/" + sensor + "/image_raw", 1000,
+        [&stamps, sensor](const sensor_msgs::Image::ConstPtr& m) { stamps[sensor].push_back(m->header.stamp); }));
+  }
+  constexpr size_t kFrames = 120;
+  ASSERT_TRUE(waitFor([&] {
+    for (const std::string& sensor : sensors) {
+      if (stamps[sensor].size() < kFrames) return false;
+    }
+    return true;
+  }, 60.0));
+  for (const std::string& sensor : sensors) {
+    const std::vector<ros::Time>& s = stamps[sensor];
+    int gaps = 0;
+    for (size_t i = 1; i < kFrames; ++i) {
+      const double step = (s[i] - s[i - 1]).toSec();
+      if (std::abs(step - 1.0 / 60.0) > 1e-6) ++gaps;
+    }
+    EXPECT_EQ(gaps, 0) << sensor << ": frames missing or out of order";
+  }
+  // All four render the same frames: the latest of their first stamps is in every list.
+  ros::Time first;
+  for (const std::string& sensor : sensors) first = std::max(first, stamps[sensor].front());
+  for (const std::string& sensor : sensors) {
+    EXPECT_NE(std::find(stamps[sensor].begin(), stamps[sensor].end(), first), stamps[sensor].end()) << sensor;
+  }
 }
 
 TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajectory) {
