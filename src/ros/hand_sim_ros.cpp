@@ -308,7 +308,8 @@ void HandSimRos::onBasePose(const geometry_msgs::PoseStamped::ConstPtr& msg) {
     if (!msg->header.frame_id.empty() && msg->header.frame_id != "world") {
       throw Error("its frame_id is '" + msg->header.frame_id + "'; give it in 'world'");
     }
-    sim_->setBasePose(fromPoseMsg(msg->pose, "~base_pose"));
+    // Over the next frame: poses streamed at the frame rate move the hand smoothly.
+    sim_->setBasePose(fromPoseMsg(msg->pose, "~base_pose"), frame_period_ns_ * 1e-9);
   } catch (const Error& e) {
     ROS_WARN_THROTTLE(1.0, "hand_sim: ~base_pose refused, nothing changed: %s", e.what());
   }

@@ -521,5 +521,29 @@ TEST(HandSimGrasp, TheBuiltInGripperAsAUrdfHoldsTheCubeAsGripperSimDoes) {
   EXPECT_LT(hand.objectInWorld().translation().z(), 0.2 - 0.0128);  // below the gel pads
 }
 
+TEST(HandSimGrasp, Wsg50PicksTheCubeOffTheFloorAsItsBaseRises) {
+  // Turned upside down over a cube on the floor, closed at 10 N a finger, then its base lifted
+  // 50 mm in 1 s: the cube rises with it, held by the gels' friction alone.
+  HandSimConfig config;
+  config.hand = loadHandConfig(kRobots + "/wsg50/wsg50_top_grasp.yaml");
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 0.015));
+  HandSim sim(config);
+  sim.step(200);
+  EXPECT_NEAR(sim.objectInWorld().translation().z(), 0.015, 1e-4);
+  sim.setOpening(0.0);
+  sim.step(1500);
+  ASSERT_TRUE(sim.contact(0).in_contact && sim.contact(1).in_contact);
+  EXPECT_NEAR(sim.contact(0).normal_force_n, 10.0, 0.1);
+  Eigen::Isometry3d up = sim.basePose();
+  up.translation().z() += 0.05;
+  sim.setBasePose(up, 1.0);
+  sim.step(500);
+  EXPECT_NEAR(sim.basePose().translation().z(), 0.133 + 0.025, 1e-9);  // halfway
+  sim.step(1500);
+  EXPECT_NEAR(sim.objectInWorld().translation().z(), 0.065, 0.2e-3);
+  EXPECT_TRUE(sim.contact(0).in_contact && sim.contact(1).in_contact);
+  test::expectError([&] { sim.setBasePose(up, -1.0); }, {"duration"});
+}
+
 }  // namespace
 }  // namespace norm2tex

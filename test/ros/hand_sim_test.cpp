@@ -8,12 +8,14 @@
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
+#include "norm2tex/GripperCommand.h"
 #include "norm2tex/HandReset.h"
 #include "norm2tex/HandStep.h"
 #include "wait_for.hpp"
@@ -146,6 +148,37 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   EXPECT_TRUE(reset.response.success) << reset.response.message;
   const auto open = hand.stepFrames(1);
   EXPECT_FALSE(open.in_contact[0] || open.in_contact[1]);
+  // The parallel GripperCommand of a two-finger hand closes it; ~base_pose streamed a pose per
+  // frame lifts it, and the cube with it.
+  ros::Publisher gripper = hand.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 1);
+  ros::Publisher base = hand.nh.advertise<geometry_msgs::PoseStamped>("/hand_sim/base_pose", 100);
+  ASSERT_TRUE(waitFor([&] { return gripper.getNumSubscribers() > 0 && base.getNumSubscribers() > 0; }, 30.0));
+  norm2tex::GripperCommand command;
+  command.mode = norm2tex::GripperCommand::ABSOLUTE;
+  command.opening = 0.0;
+  gripper.publish(command);
+  // The command is taken before the next ~step: hand_sim handles it as it arrives.
+  ASSERT_TRUE(waitFor([&] {
+    return hand.stepFrames(1).in_contact == std::vector<std::uint8_t>{1, 1};
+  }, 30.0));
+  hand.stepFrames(60);
+  geometry_msgs::PoseStamped pose;
+  pose.header.frame_id = "world";
+  pose.pose.position.z = 0.133;
+  pose.pose.orientation.x = 1.0;  // the hand upside down: 180 degrees about x
+  unsigned published = 0;
+  for (int k = 1; k <= 30; ++k) {
+    pose.pose.position.z = 0.133 + 0.001 * k;
+    base.publish(pose);
+    ++published;
+    hand.stepFrames(1);
+  }
+  const auto lifted = hand.stepFrames(10);
+  EXPECT_TRUE(lifted.in_contact[0] && lifted.in_contact[1]);
+  const geometry_msgs::TransformStamped cube_in_world =
+      hand.buffer.lookupTransform("world", "object", lifted.stamp, ros::Duration(5.0));
+  EXPECT_GT(cube_in_world.transform.translation.z, 0.015 + 0.02) << published << " poses sent";
+
   norm2tex::HandStep zero;
   zero.request.frames = 0;
   ASSERT_TRUE(hand.step.call(zero));

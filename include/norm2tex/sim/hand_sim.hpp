@@ -108,9 +108,12 @@ class HandSim {
   /// the hand yaml names no gripper joints, or for an opening outside [0, 1].
   void setOpening(double opening);
 
-  /// Moves the hand's root (a floating hand moved by its arm). Throws Error for a pose that is
-  /// not finite or not a rotation.
-  void setBasePose(const Eigen::Isometry3d& base_in_world);
+  /// Moves the hand's root (a floating hand moved by its arm): at once, or, with `duration_s` >
+  /// 0, along a straight line (and the shortest rotation) at constant speed over that much
+  /// simulated time (an arm streaming poses at the frame rate moves the hand smoothly; a jump
+  /// would leave a held object behind). Throws Error for a pose that is not finite or not a
+  /// rotation, or a negative duration.
+  void setBasePose(const Eigen::Isometry3d& base_in_world, double duration_s = 0.0);
   Eigen::Isometry3d basePose() const { return base_pose_; }
 
   /// Starts again: every joint, drive and target at its initial position (no trajectory), the
@@ -160,6 +163,7 @@ class HandSim {
   std::vector<int> validateNames(const std::vector<std::string>& names) const;
   double clampToLimits(int joint, double value, bool& clamped) const;
   void advanceTrajectory();
+  void advanceBase();
   void moveJoints(double dt);
   void forwardKinematics();
   void placeBodies();
@@ -189,6 +193,9 @@ class HandSim {
   /// Per link: the joints from the root to it (movable only).
   std::vector<std::vector<int>> link_joints_;
   Eigen::Isometry3d base_pose_ = Eigen::Isometry3d::Identity();
+  /// A base motion in progress: from, to, and its ticks done / in all.
+  Eigen::Isometry3d base_from_ = Eigen::Isometry3d::Identity(), base_to_ = Eigen::Isometry3d::Identity();
+  int base_tick_ = 0, base_ticks_ = 0;
   Trajectory trajectory_;
   bool following_trajectory_ = false;
 

@@ -511,9 +511,23 @@ void HandSim::setOpening(double opening) {
   setJointTargets(h.gripper_joints, positions);
 }
 
-void HandSim::setBasePose(const Eigen::Isometry3d& base_in_world) {
+void HandSim::setBasePose(const Eigen::Isometry3d& base_in_world, double duration_s) {
   if (!isPose(base_in_world)) throw Error("base pose is not a finite rigid pose");
-  base_pose_ = base_in_world;
+  if (!(duration_s >= 0.0 && duration_s <= 3600.0)) throw Error("base motion duration must be in [0, 3600] s");
+  base_from_ = base_pose_;
+  base_to_ = base_in_world;
+  base_tick_ = 0;
+  base_ticks_ = static_cast<int>(std::lround(duration_s / tickSeconds()));
+  if (base_ticks_ == 0) base_pose_ = base_in_world;
+}
+
+void HandSim::advanceBase() {
+  if (base_tick_ >= base_ticks_) return;
+  const double s = static_cast<double>(++base_tick_) / base_ticks_;
+  const Eigen::Quaterniond from(base_from_.linear()), to(base_to_.linear());
+  base_pose_ = Eigen::Isometry3d::Identity();
+  base_pose_.linear() = from.slerp(s, to).toRotationMatrix();
+  base_pose_.translation() = (1.0 - s) * base_from_.translation() + s * base_to_.translation();
 }
 
 void HandSim::resetObject(const Eigen::Isometry3d& object_in_world, bool gravity) {
@@ -540,6 +554,7 @@ void HandSim::reset(const Eigen::Isometry3d* object_in_world) {
   std::fill(contact_stiffness_.begin(), contact_stiffness_.end(), 0.0);
   following_trajectory_ = false;
   base_pose_ = config_.hand.base_pose;
+  base_tick_ = base_ticks_ = 0;
   forwardKinematics();
   buildWorld();
 }
@@ -808,6 +823,7 @@ void HandSim::step(int ticks) {
   const double dt = tickSeconds() / substeps;
   for (int t = 0; t < ticks; ++t) {
     advanceTrajectory();
+    advanceBase();
     for (int s = 0; s < substeps; ++s) {
       moveJoints(dt);
       updateGelContacts();
