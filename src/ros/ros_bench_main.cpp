@@ -2,6 +2,10 @@
 // to this subscriber.
 //   norm2tex_ros_bench synchronous [FRAMES]   frames/s of ~step (one call per frame, the policy
 //                                             loop; and one call for all frames)
+//   norm2tex_ros_bench hand_synchronous [FRAMES]
+//                                             the same policy loop against a running
+//                                             hand_sim.launch, every sensor of its hand
+//                                             delivered (frames/s and images/s)
 //   norm2tex_ros_bench real_time [FRAMES] [split]
 //                                             latency from a frame's stamp to its images'
 //                                             arrival here (wall-clock stamps), p50 / p99 / max;
@@ -25,6 +29,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
+#include "norm2tex/HandStep.h"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/Step.h"
 #include "wait_for.hpp"
@@ -54,9 +59,47 @@ double percentile(std::vector<double> v, double p) {
 
 }  // namespace
 
+/// hand_synchronous: the policy loop (one ~step, then every sensor's image of it) against
+/// hand_sim, however many sensors its hand has.
+int benchHandSynchronous(ros::NodeHandle& nh, int frames) {
+  std::vector<std::string> sensors;
+  if (!waitFor([&] { return nh.getParam("hand_sim/sensors", sensors); }, 60, 0.05)) {
+    return fail("no hand_sim/sensors parameter within 60 s (is hand_sim.launch running?)");
+  }
+  std::map<ros::Time, size_t> count;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string& sensor : sensors) {
+    subs.push_back(nh.subscribe<sensor_msgs::Image>(
+        sensor + "/image_raw", 2 * frames + 200,
+        [&](const sensor_msgs::Image::ConstPtr& m) { ++count[m->header.stamp]; }, {},
+        ros::TransportHints().tcpNoDelay()));
+  }
+  ros::ServiceClient step = nh.serviceClient<norm2tex::HandStep>("hand_sim/step", true);
+  if (!step.waitForExistence(ros::Duration(60.0))) return fail("no hand_sim/step within 60 s");
+  norm2tex::HandStep srv;
+  srv.request.frames = 1;
+  for (int i = 0; i < 20; ++i) step.call(srv);  // warm up
+  waitFor([&] { return count[srv.response.stamp] == sensors.size(); }, 10);
+  const ros::WallTime start = ros::WallTime::now();
+  for (int i = 0; i < frames; ++i) {
+    if (!step.call(srv) || !srv.response.success) return fail(("~step failed: " + srv.response.message).c_str());
+    const ros::Time stamp = srv.response.stamp;
+    if (!waitFor([&] { return count[stamp] == sensors.size(); }, 10)) {
+      return fail("a step's images did not all arrive within 10 s");
+    }
+  }
+  const double loop = (ros::WallTime::now() - start).toSec();
+  std::printf("hand_synchronous, %d frames, %zu sensors delivered: policy loop (step 1 + wait) "
+              "%.0f frames/s (%.2f ms/frame), %.0f images/s\n",
+              frames, sensors.size(), frames / loop, 1e3 * loop / frames,
+              frames * sensors.size() / loop);
+  return 0;
+}
+
 int main(int argc, char** argv) {
   const char* const usage =
       "usage: norm2tex_ros_bench synchronous [FRAMES >= 10]\n"
+      "       norm2tex_ros_bench hand_synchronous [FRAMES >= 10]\n"
       "       norm2tex_ros_bench real_time [FRAMES >= 10] [split] [--arrivals FILE]\n";
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
@@ -82,13 +125,14 @@ int main(int argc, char** argv) {
   // A malformed FRAMES counts as too few: the usage, not an uncaught exception.
   const int frames = args.size() > 1 ? std::atoi(args[1].c_str()) : 600;
   const bool split = args.size() > 2 && args[2] == "split";
-  const bool bad_mode = mode != "synchronous" && mode != "real_time";
+  const bool bad_mode = mode != "synchronous" && mode != "real_time" && mode != "hand_synchronous";
   if (bad_mode || frames < 10 || (args.size() > 2 && !split) || args.size() > 3 || bad ||
       (!arrivals_file.empty() && mode != "real_time")) {
     std::fputs(usage, stderr);
     return 2;
   }
   ros::NodeHandle nh;
+  if (mode == "hand_synchronous") return benchHandSynchronous(nh, frames);
   Arrivals arrivals;
   auto on_image = [&](const sensor_msgs::Image::ConstPtr& m) {
     ++arrivals.total;
