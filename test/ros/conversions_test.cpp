@@ -150,6 +150,8 @@ TEST(ConversionsTest, ImageMessagesComeBackAsTheSamePixels) {
   rgb.encoding = "rgb8";
   rgb.data.resize(5);
   test::expectError([&] { ros_conversions::fromImageMsg(rgb); }, {"truncated"});
+  rgb.data.resize(9);  // more than step x height: inconsistent too (cv_bridge refuses it)
+  test::expectError([&] { ros_conversions::fromImageMsg(rgb); }, {"holds 9 bytes", "inconsistent"});
 }
 
 TEST(ConversionsTest, CameraInfoCarriesTheSensorIntrinsics) {
