@@ -1,11 +1,10 @@
 #include "conversions.hpp"
 
-#include <opencv2/imgproc.hpp>
-
-#include <cstring>
 #include <limits>
 
-#include <boost/make_shared.hpp>
+#include <cv_bridge/cv_bridge.h>
+#include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include "norm2tex/common/error.hpp"
 
@@ -13,24 +12,20 @@ namespace norm2tex {
 namespace ros_conversions {
 
 geometry_msgs::Transform toTransformMsg(const Eigen::Isometry3d& pose) {
-  geometry_msgs::Transform msg;
-  msg.translation.x = pose.translation().x();
-  msg.translation.y = pose.translation().y();
-  msg.translation.z = pose.translation().z();
-  const Eigen::Quaterniond q(pose.rotation());
-  msg.rotation.x = q.x();
-  msg.rotation.y = q.y();
-  msg.rotation.z = q.z();
-  msg.rotation.w = q.w();
-  return msg;
+  return tf2::eigenToTransform(pose).transform;
 }
 
 Eigen::Isometry3d fromTransformMsg(const geometry_msgs::Transform& msg) {
+  // tf2_eigen's fields, and the quaternion normalised before it becomes a matrix (which
+  // tf2::transformToEigen does not do): quaternions composed along a TF chain drift off unit
+  // length, and the renderer's pose must stay a rotation.
+  Eigen::Vector3d translation;
+  tf2::fromMsg(msg.translation, translation);
+  Eigen::Quaterniond rotation;
+  tf2::fromMsg(msg.rotation, rotation);
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.translation() = Eigen::Vector3d(msg.translation.x, msg.translation.y, msg.translation.z);
-  pose.linear() = Eigen::Quaterniond(msg.rotation.w, msg.rotation.x, msg.rotation.y, msg.rotation.z)
-                      .normalized()
-                      .toRotationMatrix();
+  pose.translation() = translation;
+  pose.linear() = rotation.normalized().toRotationMatrix();
   return pose;
 }
 
@@ -65,31 +60,23 @@ TactileContact toContactMsg(const std_msgs::Header& header, const std::string& s
 }
 
 sensor_msgs::ImagePtr toImageMsg(const std_msgs::Header& header, const cv::Mat& image) {
-  auto msg = boost::make_shared<sensor_msgs::Image>();
-  msg->header = header;
+  std::string encoding;
   switch (image.type()) {
     case CV_8UC3:
-      msg->encoding = "bgr8";
+      encoding = sensor_msgs::image_encodings::BGR8;
       break;
     case CV_8UC1:
-      msg->encoding = "mono8";
+      encoding = sensor_msgs::image_encodings::MONO8;
       break;
     case CV_32FC1:
-      msg->encoding = "32FC1";
+      encoding = sensor_msgs::image_encodings::TYPE_32FC1;
       break;
     default:
       throw Error("image type " + std::to_string(image.type()) +
                   " has no sensor_msgs encoding here; valid: CV_8UC3, CV_8UC1, CV_32FC1");
   }
-  msg->height = static_cast<std::uint32_t>(image.rows);
-  msg->width = static_cast<std::uint32_t>(image.cols);
-  msg->is_bigendian = false;
-  msg->step = static_cast<std::uint32_t>(image.cols * image.elemSize());
-  msg->data.resize(static_cast<std::size_t>(msg->step) * image.rows);
-  for (int r = 0; r < image.rows; ++r) {
-    std::memcpy(&msg->data[static_cast<std::size_t>(r) * msg->step], image.ptr(r), msg->step);
-  }
-  return msg;
+  // One copy of the pixels (row by row for a view into a larger matrix).
+  return cv_bridge::CvImage(header, encoding, image).toImageMsg();
 }
 
 cv::Mat fromImageMsg(const sensor_msgs::Image& msg) {
@@ -104,20 +91,23 @@ cv::Mat fromImageMsg(const sensor_msgs::Image& msg) {
   if (msg.is_bigendian && type == CV_32FC1) {
     throw Error("big-endian 32FC1 images are not supported");
   }
+  // Checked here, naming the sizes (cv_bridge refuses such a message with less to go on).
   const std::size_t row_bytes = static_cast<std::size_t>(msg.width) * CV_ELEM_SIZE(type);
   if (msg.width == 0 || msg.height == 0 || msg.step < row_bytes ||
-      msg.data.size() < static_cast<std::size_t>(msg.step) * msg.height) {
+      msg.data.size() != static_cast<std::size_t>(msg.step) * msg.height) {
     throw Error("image message of " + std::to_string(msg.width) + " x " +
                 std::to_string(msg.height) + " " + msg.encoding + " with step " +
                 std::to_string(msg.step) + " holds " + std::to_string(msg.data.size()) +
                 " bytes: truncated or inconsistent");
   }
-  cv::Mat image(static_cast<int>(msg.height), static_cast<int>(msg.width), type);
-  for (int r = 0; r < image.rows; ++r) {
-    std::memcpy(image.ptr(r), &msg.data[static_cast<std::size_t>(r) * msg.step], row_bytes);
+  // A copy without the rows' padding; rgb8 (other drivers) arrives as BGR.
+  try {
+    return cv_bridge::toCvCopy(msg,
+                               type == CV_8UC3 ? sensor_msgs::image_encodings::BGR8 : msg.encoding)
+        ->image;
+  } catch (const cv_bridge::Exception& e) {
+    throw Error("image message of encoding '" + msg.encoding + "': " + e.what());
   }
-  if (msg.encoding == "rgb8") cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
-  return image;
 }
 
 sensor_msgs::CameraInfo toCameraInfo(const std_msgs::Header& header, const SensorModel& model) {

@@ -11,6 +11,7 @@
 
 #include "norm2tex/TactileContact.h"
 
+#include "lock_step.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/common/output_directory.hpp"
@@ -160,7 +161,7 @@ void DatasetRecorder::announceReady() {
   ready_timer_.stop();
   FrameRendered ready;
   ready.sensor = params_.answer_as;
-  ready.reason = "ready";
+  ready.reason = lock_step::kReady;
   answer_pub_.publish(ready);
 }
 
@@ -316,6 +317,14 @@ void DatasetRecorder::answerFramesWritten() {
 void DatasetRecorder::close() {
   if (closed_) return;
   closed_ = true;
+  // Finished (or stopped): leave the lock-step, so that the frame source stops waiting for
+  // answers this recorder will not give. First, so it is on its way while the bag is indexed.
+  if (!params_.answer_as.empty() && answer_pub_ && ros::ok()) {
+    FrameRendered leaving;
+    leaving.sensor = params_.answer_as;
+    leaving.reason = lock_step::kLeaving;
+    answer_pub_.publish(leaving);
+  }
   if (stop_reason_.empty()) stop_reason_ = stop_reason::kShutdown;
   try {
     if (bag_) bag_->close();  // writes the index: `rosbag info` reads it

@@ -11,9 +11,11 @@
 #include <string>
 #include <vector>
 
+#include <cv_bridge/cv_bridge.h>
 #include <ros/master.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/image_encodings.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "contact_sheet.hpp"
@@ -34,11 +36,7 @@ struct Latest {
 };
 
 cv::Mat3b toMat(const sensor_msgs::Image& msg) {
-  if (msg.encoding != "bgr8") throw std::runtime_error("expected bgr8, got " + msg.encoding);
-  return cv::Mat3b(static_cast<int>(msg.height), static_cast<int>(msg.width),
-                   const_cast<cv::Vec3b*>(reinterpret_cast<const cv::Vec3b*>(msg.data.data())),
-                   msg.step)
-      .clone();
+  return cv_bridge::toCvCopy(msg, sensor_msgs::image_encodings::BGR8)->image;
 }
 
 }  // namespace

@@ -65,33 +65,53 @@ bool LockStep::serveAnswersUntil(std::unique_lock<std::mutex>& lock,
 }
 
 void LockStep::onRendered(const FrameRendered::ConstPtr& msg) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ready_.insert(msg->sensor);  // a renderer's first message (latched) says it is ready
-    const auto it = in_flight_.find(msg->frame);
-    const bool listed =
-        std::find(renderers_.begin(), renderers_.end(), msg->sensor) != renderers_.end();
-    if (listed && it != in_flight_.end() && it->second.frame.header.stamp == msg->header.stamp &&
-        it->second.answered.insert(msg->sensor).second) {
-      ++answers_;
-      if (!msg->published) {
-        ++missing_images_;
-        ROS_WARN("%s: %s published no image for frame %lu: %s", owner_.c_str(), msg->sensor.c_str(),
-                 static_cast<unsigned long>(msg->frame), msg->reason.c_str());
-      }
-      // Frames leave in order once every listed renderer has answered them.
-      while (!in_flight_.empty() &&
-             in_flight_.begin()->second.answered.size() == renderers_.size()) {
-        in_flight_.erase(in_flight_.begin());
-      }
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool listed =
+      std::find(renderers_.begin(), renderers_.end(), msg->sensor) != renderers_.end();
+  if (msg->reason == lock_step::kLeaving) {
+    // Announced, then not waited for: neither for the next frames nor for those in flight.
+    if (listed && left_.insert(msg->sensor).second) {
+      ROS_INFO("%s: %s left the lock-step; frames no longer wait for it", owner_.c_str(),
+               msg->sensor.c_str());
+      ++answers_;  // progress: the frames it held may leave now
+      releaseAnswered();
     }
+    return;
+  }
+  ready_.insert(msg->sensor);  // a renderer's first message (latched) says it is ready
+  if (msg->reason == lock_step::kReady && left_.erase(msg->sensor)) {
+    ROS_INFO("%s: %s joined the lock-step again", owner_.c_str(), msg->sensor.c_str());
+  }
+  const auto it = in_flight_.find(msg->frame);
+  if (listed && it != in_flight_.end() && it->second.frame.header.stamp == msg->header.stamp &&
+      it->second.answered.insert(msg->sensor).second) {
+    ++answers_;
+    if (!msg->published) {
+      ++missing_images_;
+      ROS_WARN("%s: %s published no image for frame %lu: %s", owner_.c_str(), msg->sensor.c_str(),
+               static_cast<unsigned long>(msg->frame), msg->reason.c_str());
+    }
+    releaseAnswered();
+  }
+}
+
+bool LockStep::waitsFor(const std::string& sensor) const { return !left_.count(sensor); }
+
+void LockStep::releaseAnswered() {
+  // Frames leave in order once every participant still waited for has answered them.
+  while (!in_flight_.empty()) {
+    const std::set<std::string>& answered = in_flight_.begin()->second.answered;
+    for (const std::string& r : renderers_) {
+      if (waitsFor(r) && !answered.count(r)) return;
+    }
+    in_flight_.erase(in_flight_.begin());
   }
 }
 
 std::string LockStep::notReady() const {
   std::string names;
   for (const std::string& sensor : renderers_) {
-    if (!ready_.count(sensor)) names += " " + sensor;
+    if (waitsFor(sensor) && !ready_.count(sensor)) names += " " + sensor;
   }
   return names;
 }
@@ -121,7 +141,7 @@ std::uint32_t LockStep::waitForAnswers(std::unique_lock<std::mutex>& lock,
       std::string missing;
       const InFlight& oldest = in_flight_.begin()->second;
       for (const std::string& r : renderers_) {
-        if (!oldest.answered.count(r)) missing += " " + r;
+        if (waitsFor(r) && !oldest.answered.count(r)) missing += " " + r;
       }
       throw Error("no answer from" + missing + " to frame " + std::to_string(oldest.frame.frame) +
                   " within ~render_timeout = " + ros_params::text(timeout_) + " s");
@@ -143,6 +163,7 @@ std::uint32_t LockStep::publish(const ros::Publisher& frame_pub, const SimFrame&
   std::uint32_t missing = waitForAnswers(lock, frame_pub, window_ - 1);
   in_flight_[frame.frame] = InFlight{frame, {}};
   frame_pub.publish(frame);
+  releaseAnswered();  // every participant may have left: then nobody answers
   if (window_ == 1) missing += waitForAnswers(lock, frame_pub, 0);
   return missing;
 }

@@ -18,6 +18,15 @@
 
 namespace norm2tex {
 
+/// FrameRendered.reason of the two announcements a participant of the lock-step makes besides
+/// its answers: it is ready for frames (its first, latched message), or it leaves for good (a
+/// recorder that has its samples or was stopped): the source stops waiting for it from then on,
+/// including for the frames already in flight. A later "ready" under the same name joins again.
+namespace lock_step {
+constexpr const char* kReady = "ready";
+constexpr const char* kLeaving = "leaving";
+}  // namespace lock_step
+
 /// Reads a frame source's ~renderers (names, no spaces), ~render_timeout (0, 600] s and
 /// ~ready_timeout (0, 3600] s, keeping the given values as defaults; throws Error naming the
 /// parameter at fault.
@@ -32,6 +41,7 @@ void readLockStepParams(const ros::NodeHandle& private_nh, std::vector<std::stri
 /// (a dataset: still nothing lost, drain() waits for the rest). Answers arrive on a queue of
 /// their own, which the waiting caller serves itself: it may hold the thread a nodelet manager
 /// would deliver them on, and no thread hand-over stands between an answer and the caller.
+/// A participant that announces it is leaving (lock_step::kLeaving) is not waited for any more.
 /// Not for concurrent callers (the frame sources call it from one thread at a time).
 class LockStep {
  public:
@@ -74,6 +84,12 @@ class LockStep {
                          double seconds);
   /// " name name": renderers that have not said they are ready. Call with mutex_ held.
   std::string notReady() const;
+  /// Whether frames wait for the answers of `sensor` (a listed one): it has not left. Call with
+  /// mutex_ held.
+  bool waitsFor(const std::string& sensor) const;
+  /// Lets the frames in flight that every participant still waited for has answered leave, in
+  /// order. Call with mutex_ held.
+  void releaseAnswered();
 
   std::vector<std::string> renderers_;
   double timeout_, ready_timeout_;
@@ -83,6 +99,7 @@ class LockStep {
   ros::Subscriber sub_;
   std::mutex mutex_;
   std::set<std::string> ready_;
+  std::set<std::string> left_;  ///< listed participants that announced they are leaving
   std::map<std::uint64_t, InFlight> in_flight_;  ///< by frame number
   std::uint32_t missing_images_ = 0;             ///< reported since the last publish/drain
   std::uint64_t answers_ = 0;                    ///< answers to frames in flight, ever

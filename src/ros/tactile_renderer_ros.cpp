@@ -15,6 +15,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "conversions.hpp"
+#include "lock_step.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
@@ -182,7 +183,7 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
   FrameRendered ready;
   ready.header.frame_id = params_.gel_frame;
   ready.sensor = params_.sensor_name;
-  ready.reason = "ready";
+  ready.reason = lock_step::kReady;
   rendered_pub_.publish(ready);
 }
 

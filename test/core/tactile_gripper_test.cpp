@@ -2,7 +2,9 @@
 // the same pose renders, follows contact_sim's clock and noise rule, a batch on threads equals
 // grippers run alone, and the pool runs every job once and passes errors on.
 #include <atomic>
+#include <functional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -143,27 +145,54 @@ TEST(TactileGripperTest, ABatchOnThreadsEqualsGrippersAlone) {
   EXPECT_EQ(batch.gripper(0).sim().ticks(), ticks);
 }
 
+/// The message of the Error `call` throws ("" when it throws none).
+template <class Call>
+std::string errorOf(Call&& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(TactileGripperTest, BadOptionsAreRefusedWithTheirRange) {
   const SensorModel sensor = loadSensorModel(source("config/digit.yaml"));
   const GripperSimConfig scene = loadGripperSimConfig(source("config/scenes/cube.yaml"));
-  TactileGripperOptions o;
-  o.frame_rate_hz = 0.0;
-  EXPECT_THROW(
-      {
-        try {
-          TactileGripper(scene, sensor, o);
-        } catch (const Error& e) {
-          EXPECT_NE(std::string(e.what()).find("frame_rate_hz"), std::string::npos) << e.what();
-          throw;
-        }
-      },
-      Error);
-  o = TactileGripperOptions();
-  o.beta_mm = 0.1;  // texture depth without a material
-  EXPECT_THROW(TactileGripper(scene, sensor, o), Error);
+  // Each bad option is refused naming itself, its value and what is valid.
+  struct Case {
+    std::function<void(TactileGripperOptions&)> set;
+    std::string expected;
+  };
+  const Case cases[] = {
+      {[](TactileGripperOptions& o) { o.frame_rate_hz = 0.0; },
+       "option frame_rate_hz = 0 is out of range; valid: [1, 1000] Hz and <= physics_rate_hz"},
+      {[](TactileGripperOptions& o) { o.physics_rate_hz = 50.0; },
+       "option physics_rate_hz = 50 is out of range; valid: [100, 100000] Hz"},
+      {[](TactileGripperOptions& o) { o.variant = -1; },
+       "option variant = -1 is out of range; valid: >= 0"},
+      {[](TactileGripperOptions& o) { o.friction = 6.0; },
+       "option friction = 6 is out of range; valid: [0, 5], or < 0 for the material's"},
+      // Texture depth without a material: nothing to texture.
+      {[](TactileGripperOptions& o) { o.beta_mm = 0.1; },
+       "option beta_mm = 0.1 is out of range; valid: 0 or < 0 without a material"},
+  };
+  for (const Case& c : cases) {
+    TactileGripperOptions o;
+    c.set(o);
+    const std::string message = errorOf([&] { TactileGripper(scene, sensor, o); });
+    EXPECT_NE(message.find(c.expected), std::string::npos)
+        << "expected: " << c.expected << "\ngot: " << message;
+  }
+  // And the calls: a variant for a gripper without a material, a step of no frames.
   TactileGripper textureless(scene, sensor, TactileGripperOptions());
-  EXPECT_THROW(textureless.setVariant(2), Error);
-  EXPECT_THROW(textureless.step(0), Error);
+  std::string message = errorOf([&] { textureless.setVariant(2); });
+  EXPECT_NE(message.find("texture variant 2 refused: the gripper has no material"),
+            std::string::npos)
+      << message;
+  message = errorOf([&] { textureless.step(0); });
+  EXPECT_NE(message.find("step frames = 0 refused; valid: [1, 100000]"), std::string::npos)
+      << message;
 }
 
 }  // namespace

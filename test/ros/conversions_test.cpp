@@ -1,4 +1,5 @@
 // Conversions between core types and ROS messages (no master needed).
+#include <cmath>
 #include <cstring>
 
 #include <gtest/gtest.h>
@@ -24,11 +25,41 @@ TEST(ConversionsTest, TransformRoundTripKeepsThePose) {
   EXPECT_TRUE(ros_conversions::fromTransformMsg(msg).isApprox(pose, 1e-12));
 }
 
+/// Expects the message's quaternion to be (x, y, z, w) up to its sign (q and -q are one rotation).
+void expectQuaternion(const geometry_msgs::Quaternion& q, double x, double y, double z, double w) {
+  const double sign = (q.x * x + q.y * y + q.z * z + q.w * w) < 0.0 ? -1.0 : 1.0;
+  EXPECT_NEAR(sign * q.x, x, 1e-12);
+  EXPECT_NEAR(sign * q.y, y, 1e-12);
+  EXPECT_NEAR(sign * q.z, z, 1e-12);
+  EXPECT_NEAR(sign * q.w, w, 1e-12);
+}
+
 TEST(ConversionsTest, GelFrameRotationSurvivesTheMessage) {
-  // The left gel's rotation has a 180-degree component: quaternion round trips must keep it.
-  const Eigen::Isometry3d gel = GripperSim::gelInFinger(Finger::kLeft);
+  // The components pinned, worked out by hand, so that a wrong order of x, y, z, w (even the
+  // same wrong order both ways, which a round trip alone would pass) fails. The left gel's
+  // rotation [[-1,0,0],[0,0,-1],[0,-1,0]] is a half turn (trace -1, so w = 0) about the axis
+  // with n n^T = (R + I) / 2, n = (0, 1, -1) / sqrt(2).
+  const double h = std::sqrt(0.5);
+  const Eigen::Isometry3d left = GripperSim::gelInFinger(Finger::kLeft);
+  const geometry_msgs::Transform left_msg = ros_conversions::toTransformMsg(left);
+  expectQuaternion(left_msg.rotation, 0.0, h, -h, 0.0);
+  EXPECT_TRUE(ros_conversions::fromTransformMsg(left_msg).isApprox(left, 1e-12));
+  // The right gel's [[1,0,0],[0,0,1],[0,-1,0]] is a quarter turn about x, by -90 degrees:
+  // (sin(-45), 0, 0, cos(-45)); its w is not 0, so it also catches w swapped with x.
+  const Eigen::Isometry3d right = GripperSim::gelInFinger(Finger::kRight);
+  const geometry_msgs::Transform right_msg = ros_conversions::toTransformMsg(right);
+  expectQuaternion(right_msg.rotation, -h, 0.0, 0.0, h);
+  EXPECT_TRUE(ros_conversions::fromTransformMsg(right_msg).isApprox(right, 1e-12));
+  // And the way in: a message with only w set is the identity; with only z set, a half turn
+  // about z.
+  geometry_msgs::Transform msg;
+  msg.rotation.w = 1.0;
   EXPECT_TRUE(
-      ros_conversions::fromTransformMsg(ros_conversions::toTransformMsg(gel)).isApprox(gel, 1e-12));
+      ros_conversions::fromTransformMsg(msg).linear().isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+  msg.rotation.w = 0.0;
+  msg.rotation.z = 1.0;
+  EXPECT_TRUE(ros_conversions::fromTransformMsg(msg).linear().isApprox(
+      Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal().toDenseMatrix(), 1e-12));
 }
 
 TEST(ConversionsTest, TimeIsExactToTheNanosecond) {
@@ -119,6 +150,8 @@ TEST(ConversionsTest, ImageMessagesComeBackAsTheSamePixels) {
   rgb.encoding = "rgb8";
   rgb.data.resize(5);
   test::expectError([&] { ros_conversions::fromImageMsg(rgb); }, {"truncated"});
+  rgb.data.resize(9);  // more than step x height: inconsistent too (cv_bridge refuses it)
+  test::expectError([&] { ros_conversions::fromImageMsg(rgb); }, {"holds 9 bytes", "inconsistent"});
 }
 
 TEST(ConversionsTest, CameraInfoCarriesTheSensorIntrinsics) {

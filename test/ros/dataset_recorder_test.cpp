@@ -1,18 +1,22 @@
-// rostest (dataset_recorder.test): recording in lock-step, Ctrl-C, and bad input. Waits on
+// rostest (dataset_recorder.test): recording in lock-step, Ctrl-C, and bad input;
+// (dataset_recorder_leaves.test): a recorder that has its samples leaves the lock-step. Waits on
 // conditions with deadlines.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -155,6 +159,84 @@ TEST(DatasetRecorder, BadInputExitsNamingTheCause) {
         << output;
     EXPECT_NE(output.find(c.expected), std::string::npos) << c.args << ":\n" << output;
   }
+}
+
+// Once the recorder has its ~samples and stops, it leaves the lock-step (announced, then not
+// waited for): the frame it never answers and every later ~step go on with the renderers alone,
+// each returning well within ~render_timeout (waiting for the recorder would take all of it and
+// fail), and both renderers still publish every frame's image.
+TEST(RecorderFinished, LeavesTheLockStepAndLaterStepsGoOnWithTheRenderers) {
+  ros::NodeHandle nh;
+  std::string dir;
+  ASSERT_TRUE(nh.getParam("/dataset_recorder/output_dir", dir));
+  int samples = 0;
+  ASSERT_TRUE(nh.getParam("/dataset_recorder/samples", samples));
+  ASSERT_EQ(samples, 4);  // two frames of two sensors
+  double render_timeout = 0.0;
+  ASSERT_TRUE(nh.getParam("/contact_sim/render_timeout", render_timeout));
+
+  std::map<std::string, std::set<ros::Time>> images;  // stamps received, per sensor
+  std::vector<ros::Subscriber> subscribers;
+  for (const std::string sensor : {"digit_left", "digit_right"}) {
+    subscribers.push_back(nh.subscribe<sensor_msgs::Image>(
+        "/" + sensor + "/image_raw", 100, [&images, sensor](const sensor_msgs::Image::ConstPtr& m) {
+          images[sensor].insert(m->header.stamp);
+        }));
+  }
+  ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const ros::Subscriber& s : subscribers) {
+          if (s.getNumPublishers() == 0) return false;
+        }
+        return true;
+      },
+      30.0));
+  auto bothImagesOf = [&](const ros::Time& stamp) {
+    return waitFor(
+        [&] { return images["digit_left"].count(stamp) && images["digit_right"].count(stamp); },
+        10.0);
+  };
+
+  // Three frames: the recorder writes the first two and stops; the third it never answers.
+  norm2tex::Step srv;
+  srv.request.frames = 3;
+  ASSERT_TRUE(step.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.missing_images, 0u);
+  EXPECT_TRUE(bothImagesOf(srv.response.stamp));
+  const std::uint64_t first_frames = srv.response.frame;
+
+  // The recorder finished as planned (its node gone: the manifest is written): its samples (and
+  // the frames already begun), complete.
+  ASSERT_TRUE(waitFor(
+      [] {
+        ros::V_string nodes;
+        return ros::master::getNodes(nodes) &&
+               std::find(nodes.begin(), nodes.end(), "/dataset_recorder") == nodes.end();
+      },
+      30.0, 0.05));
+  const std::string manifest = readFile(dir + "/norm2tex_shard0.yaml");
+  const std::size_t images_at = manifest.find("\nimages: ");
+  ASSERT_NE(images_at, std::string::npos) << manifest;
+  EXPECT_GE(std::stoi(manifest.substr(images_at + 9)), 4) << manifest;
+  EXPECT_NE(manifest.find("stop_reason: sample_target\n"), std::string::npos) << manifest;
+  EXPECT_NE(manifest.find("complete: true\n"), std::string::npos) << manifest;
+
+  // Later steps, one frame and several: prompt, and the renderers answer each frame.
+  for (const std::uint32_t frames : {1u, 1u, 1u, 5u}) {
+    srv = norm2tex::Step();
+    srv.request.frames = frames;
+    const ros::WallTime start = ros::WallTime::now();
+    ASSERT_TRUE(step.call(srv));
+    const double seconds = (ros::WallTime::now() - start).toSec();
+    ASSERT_TRUE(srv.response.success) << srv.response.message;
+    EXPECT_LT(seconds, render_timeout) << frames << " frame(s)";
+    EXPECT_EQ(srv.response.missing_images, 0u);
+    EXPECT_TRUE(bothImagesOf(srv.response.stamp)) << srv.response.stamp;
+  }
+  EXPECT_EQ(srv.response.frame, first_frames + 1u + 1u + 1u + 5u);
 }
 
 }  // namespace
