@@ -3,11 +3,14 @@
 // a simulator publishes it, refusals. Waits on conditions with deadlines, never sleeps.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/JointState.h>
@@ -102,6 +105,40 @@ TEST(HandSimRealTime, FourSensorsPublishAnImageOfEveryFrameAtSixtyHertz) {
   for (const std::string& sensor : sensors) {
     EXPECT_NE(std::find(stamps[sensor].begin(), stamps[sensor].end(), first), stamps[sensor].end()) << sensor;
   }
+}
+
+TEST(HandSimRecord, TheRecorderWritesEverySensorsImagesThenLeavesTheHandRunning) {
+  Hand hand;
+  std::string dir;
+  ASSERT_TRUE(hand.nh.getParam("/dataset_recorder/output_dir", dir));
+  std::vector<ros::Time> stamps;
+  for (int i = 0; i < 4; ++i) stamps.push_back(hand.stepFrames(2).stamp);  // 8 frames
+  // The recorder had its 10 images (5 frames x 2 sensors) mid-way: it closed its bag and wrote
+  // its manifest, and left the lock-step: further steps are answered by the renderers alone.
+  const std::string manifest = dir + "/hand_shard0.yaml";
+  ASSERT_TRUE(waitFor([&] { return std::filesystem::exists(manifest); }, 30.0));
+  const auto after = hand.stepFrames(5);
+  EXPECT_EQ(after.missing_images, 0u);
+  std::map<std::string, std::vector<ros::Time>> images;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".bag") continue;
+    rosbag::Bag bag(entry.path().string(), rosbag::bagmode::Read);
+    for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+      if (m.getTopic().find("/image_raw") == std::string::npos) continue;
+      if (const auto image = m.instantiate<sensor_msgs::Image>()) {
+        images[m.getTopic()].push_back(image->header.stamp);
+      }
+    }
+  }
+  ASSERT_EQ(images.size(), 2u);
+  for (const auto& [topic, topic_stamps] : images) {
+    EXPECT_EQ(topic_stamps.size(), 5u) << topic;
+    // The first five frames, each once: frames 2, 4 were the ends of the first two steps.
+    ASSERT_GE(topic_stamps.size(), 4u);
+    EXPECT_EQ(topic_stamps[1], stamps[0]) << topic;
+    EXPECT_EQ(topic_stamps[3], stamps[1]) << topic;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajectory) {
