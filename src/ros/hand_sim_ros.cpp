@@ -13,6 +13,7 @@
 
 #include "conversions.hpp"
 #include "markers.hpp"
+#include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/TactileContact.h"
 #include "norm2tex/common/error.hpp"
@@ -97,6 +98,7 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
   if (params_.material != ros_params::kNoMaterial) {
     const MaterialConfig material = loadMaterialConfig(materialConfigPath(params_.material, ", or none"));
     scene.object.friction = material.friction;
+    beta_mm_ = material.beta_mm;
   }
   if (params_.friction >= 0.0) scene.object.friction = params_.friction;
   scene.object.material = params_.material;
@@ -142,6 +144,8 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
   }
   object_marker_pub_ = private_nh_.advertise<visualization_msgs::Marker>("object_marker", 1, true);
   object_marker_pub_.publish(ros_conversions::objectMarker(sim_->object().mesh, ros::Time(0)));
+  episode_pub_ = nh_.advertise<EpisodeInfo>("episode", 1, /*latch=*/true);
+  publishEpisode();
   publishStaticTransforms();
   lock_step_ = std::make_unique<LockStep>(
       private_nh_, params_.synchronous ? params_.renderers : std::vector<std::string>(),
@@ -181,6 +185,19 @@ HandSimRos::~HandSimRos() {
 
 ros::Time HandSimRos::frameStamp() const {
   return time_base_ + (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
+}
+
+void HandSimRos::publishEpisode() {
+  EpisodeInfo info;
+  info.header.stamp = frameStamp();
+  info.header.frame_id = "world";
+  info.episode = ++episode_;
+  info.object = sim_->config().object.name;
+  info.material = params_.material;
+  info.beta = beta_mm_;
+  info.scenario = "hand";
+  info.num_shards = 1;
+  episode_pub_.publish(info);
 }
 
 void HandSimRos::publishStaticTransforms() {
@@ -342,6 +359,7 @@ bool HandSimRos::onReset(HandReset::Request& request, HandReset::Response& respo
     sim_->step(ticks_per_frame_);
     ++frame_;
     opening_command_ = 1.0;
+    publishEpisode();
     publishFrame();
     lock_step_->drain(frame_pub_);
   } catch (const Error& e) {

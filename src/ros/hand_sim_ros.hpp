@@ -73,6 +73,9 @@ class HandSimRos {
   void warnClamped(const std::vector<std::string>& clamped);
   void runClock();
   void publishStaticTransforms();
+  /// The episode's labels on /episode (latched), at start and at every ~reset: what a recording
+  /// names its images with.
+  void publishEpisode();
   std::uint32_t publishFrame();
   ros::Time frameStamp() const;
 
@@ -85,11 +88,13 @@ class HandSimRos {
   ros::Time time_base_;
   bool owns_clock_ = false;
   double opening_command_ = 1.0;
+  std::uint32_t episode_ = 0;
+  double beta_mm_ = 0.0;  ///< the material's texture depth: a label
 
   std::mutex mutex_;
   ros::CallbackQueue service_queue_;
   ros::NodeHandle nh_, private_nh_;
-  ros::Publisher tf_pub_, clock_pub_, joints_pub_, frame_pub_, object_marker_pub_;
+  ros::Publisher tf_pub_, clock_pub_, joints_pub_, frame_pub_, object_marker_pub_, episode_pub_;
   std::vector<ros::Publisher> contact_pubs_;
   std::unique_ptr<tf2_ros::StaticTransformBroadcaster> static_tf_;
   ros::Subscriber trajectory_sub_, targets_sub_, base_sub_, gripper_sub_;

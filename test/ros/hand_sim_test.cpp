@@ -18,6 +18,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
 
+#include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/HandReset.h"
 #include "norm2tex/HandStep.h"
@@ -120,16 +121,19 @@ TEST(HandSimRecord, TheRecorderWritesEverySensorsImagesThenLeavesTheHandRunning)
   const auto after = hand.stepFrames(5);
   EXPECT_EQ(after.missing_images, 0u);
   std::map<std::string, std::vector<ros::Time>> images;
+  std::string material;  // the labels the exporter names the images with
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".bag") continue;
     rosbag::Bag bag(entry.path().string(), rosbag::bagmode::Read);
     for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+      if (const auto info = m.instantiate<norm2tex::EpisodeInfo>()) material = info->material;
       if (m.getTopic().find("/image_raw") == std::string::npos) continue;
       if (const auto image = m.instantiate<sensor_msgs::Image>()) {
         images[m.getTopic()].push_back(image->header.stamp);
       }
     }
   }
+  EXPECT_EQ(material, "wood");
   ASSERT_EQ(images.size(), 2u);
   for (const auto& [topic, topic_stamps] : images) {
     EXPECT_EQ(topic_stamps.size(), 5u) << topic;
