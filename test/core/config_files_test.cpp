@@ -10,6 +10,7 @@
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
+#include "norm2tex/sim/hand_sim.hpp"
 
 namespace norm2tex {
 namespace {
@@ -26,6 +27,13 @@ TEST(ConfigFilesTest, EveryShippedYamlLoads) {
       EXPECT_NO_THROW(loadMaterialConfig(path));
     } else if (folder == "scenes") {
       EXPECT_NO_THROW(loadGripperSimConfig(path));
+    } else if (folder == "hands") {
+      // A hand yaml, its URDF and every mesh it names: the whole hand builds.
+      EXPECT_NO_THROW({
+        HandSimConfig hand;
+        hand.hand = loadHandConfig(path);
+        HandSim sim(hand);
+      });
     } else if (entry.path().filename() == "digit.yaml") {
       EXPECT_NO_THROW(loadSensorModel(path));
     } else {
@@ -33,7 +41,7 @@ TEST(ConfigFilesTest, EveryShippedYamlLoads) {
     }
     ++loaded;
   }
-  EXPECT_GE(loaded, 8);  // digit, 5 materials, 2 scenes
+  EXPECT_GE(loaded, 9);  // digit, 5 materials, 2 scenes, the built-in hand
 }
 
 // Shipped Python scripts run on the user's python3, found on PATH: `#!/usr/bin/python3` would

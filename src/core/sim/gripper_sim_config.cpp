@@ -8,24 +8,12 @@
 
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
+#include "sim/yaml_keys.hpp"
 
 namespace norm2tex {
 namespace {
 
-// A misspelled key must not silently keep a default: every section lists what it accepts.
-void requireKnownKeys(const YAML::Node& section, const std::string& name,
-                      const std::set<std::string>& keys) {
-  if (!section) return;
-  if (!section.IsMap()) throw Error(name + " must be a map");
-  for (const auto& entry : section) {
-    const std::string key = entry.first.as<std::string>();
-    if (!keys.count(key)) {
-      std::string valid;
-      for (const std::string& k : keys) valid += (valid.empty() ? "" : ", ") + k;
-      throw Error((name.empty() ? "" : name + ".") + key + " is not a known key; valid: " + valid);
-    }
-  }
-}
+using detail::requireKnownKeys;
 
 template <typename T>
 void read(const YAML::Node& section, const char* key, T& value) {
