@@ -47,6 +47,12 @@ _CORE_NAMES = (
     "GelLaw",
     "TactileGripperOptions",
     "TactileGripperBatch",
+    "SensorMount",
+    "HandConfig",
+    "HandSimConfig",
+    "HandSim",
+    "TactileHandOptions",
+    "TactileHand",
 )
 
 __all__ = list(_CORE_NAMES) + ["config_dir", "config_path", "material_config", "scene_config"]

@@ -21,6 +21,7 @@ PYBIND11_MODULE(_core, m) {
   py::register_exception<norm2tex::Error>(m, "Error", PyExc_RuntimeError);
   norm2tex::python::bindRender(m);
   norm2tex::python::bindSim(m);
+  norm2tex::python::bindHand(m);
   m.attr("SOURCE_CONFIG_DIR") = NORM2TEX_SOURCE_CONFIG_DIR;
   m.attr("__version__") = NORM2TEX_VERSION;
 }

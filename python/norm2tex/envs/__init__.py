@@ -1,4 +1,5 @@
-"""Gymnasium-style environments over the simulated gripper with two DIGITs.
+"""Gymnasium-style environments over the simulated gripper with two DIGITs (GripperEnv,
+HoldCubeEnv) and over any hand with DIGITs from its URDF (HandEnv).
 
     from norm2tex.envs import HoldCubeEnv
     env = HoldCubeEnv()
@@ -11,6 +12,7 @@ norm2tex.envs.spaces, with the same attributes.
 """
 
 from norm2tex.envs.gripper_env import GripperEnv, GripperVectorEnv  # noqa: F401
+from norm2tex.envs.hand_env import HandEnv  # noqa: F401
 from norm2tex.envs.hold_cube import (  # noqa: F401
     HoldCubeEnv,
     HoldCubeVectorEnv,

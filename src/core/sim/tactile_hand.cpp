@@ -1,0 +1,163 @@
+#include "norm2tex/sim/tactile_hand.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "norm2tex/common/error.hpp"
+#include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/sim/tactile_gripper.hpp"
+
+namespace norm2tex {
+namespace {
+
+std::string text(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+/// Variants a hand keeps generated when it has a cache of its own.
+constexpr std::size_t kKeptVariants = 32;
+
+}  // namespace
+
+void validate(const TactileHandOptions& o) {
+  auto bad = [](const std::string& name, const std::string& value, const std::string& valid) {
+    throw Error("tactile hand option " + name + " = " + value + " is out of range; valid: " + valid);
+  };
+  if (!(o.physics_rate_hz >= 100.0 && o.physics_rate_hz <= 100000.0)) {
+    bad("physics_rate_hz", text(o.physics_rate_hz), "[100, 100000] Hz");
+  }
+  if (!(o.frame_rate_hz >= 1.0 && o.frame_rate_hz <= 1000.0 &&
+        o.frame_rate_hz <= o.physics_rate_hz)) {
+    bad("frame_rate_hz", text(o.frame_rate_hz), "[1, 1000] Hz and <= physics_rate_hz");
+  }
+  if (o.variant < 0) bad("variant", text(o.variant), ">= 0");
+  if (!(o.beta_mm < 0.0 || o.beta_mm <= 2.0)) {
+    bad("beta_mm", text(o.beta_mm), "[0, 2] mm, or < 0 for the material's");
+  }
+  if (!(o.friction < 0.0 || o.friction <= 5.0) || std::isnan(o.friction)) {
+    bad("friction", text(o.friction), "[0, 5], or < 0 for the material's");
+  }
+  if (o.material_config.empty() && o.beta_mm > 0.0) {
+    bad("beta_mm", text(o.beta_mm), "0 or < 0 without a material (nothing to texture)");
+  }
+}
+
+TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
+                         const TactileHandOptions& options,
+                         std::shared_ptr<ObjectTextureCache> textures)
+    : options_(options), textures_(std::move(textures)), variant_(options.variant) {
+  validate(options_);
+  validate(sensor);
+  std::optional<MaterialConfig> material;
+  if (!options_.material_config.empty()) material = loadMaterialConfig(options_.material_config);
+  // As TactileGripper: the material's friction unless one is given.
+  config.object.friction = options_.friction >= 0.0 ? options_.friction
+                           : material               ? material->friction
+                                                    : kDefaultTactileFriction;
+  if (material) config.object.material = material->name;
+  config.gel_width_m = sensor.gel_pad_width_mm * 1e-3;
+  config.gel_height_m = sensor.gel_pad_height_mm * 1e-3;
+  config.gel_thickness_m = sensor.gel_thickness_mm * 1e-3;
+  // Whole physics ticks per sensor frame, so every frame is a physics state.
+  ticks_per_frame_ = std::max(
+      1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
+  config.physics.rate_hz = ticks_per_frame_ * options_.frame_rate_hz;
+  sim_ = std::make_unique<HandSim>(config);
+  mesh_ = std::make_shared<TexturedMesh>(sim_->object().mesh);
+  for (int s = 0; s < sim_->sensorCount(); ++s) {
+    // A sensor's own model (the hand yaml's `sensor`) wins, as in hand_sim.launch.
+    const std::string& own = sim_->sensor(s).sensor_yaml;
+    renderers_.push_back(own.empty() ? std::make_unique<TactileRenderer>(sensor)
+                                     : std::make_unique<TactileRenderer>(loadSensorModel(own)));
+  }
+  frames_.assign(renderers_.size(), nullptr);
+
+  beta_mm_ = material ? (options_.beta_mm >= 0.0 ? options_.beta_mm : material->beta_mm) : 0.0;
+  if (beta_mm_ > 0.0) {
+    if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(kKeptVariants);
+    TextureSource source;
+    source.material_config = options_.material_config;
+    source.variant = variant_;
+    source.seed = options_.material_seed;
+    const std::string key = options_.material_config + "#" +
+                            std::to_string(options_.material_seed) + "/" + std::to_string(variant_);
+    std::shared_ptr<const ObjectTexture> texture;
+    if (!mesh_->hasUvs()) {
+      // A mesh without UVs is unwrapped for its texture, on this hand's own mesh (as
+      // TactileGripper does), so every sensor renders the unwrapped mesh.
+      auto unwrapped = std::make_shared<ObjectTexture>(loadObjectTexture(source, *mesh_));
+      texture = textures_->get(key, [&] { return *unwrapped; }).texture;
+    } else {
+      std::shared_ptr<const TexturedMesh> mesh = mesh_;
+      texture = textures_->get(key, [source, mesh] {
+        TexturedMesh copy = *mesh;
+        return loadObjectTexture(source, copy);
+      }).texture;
+    }
+    for (auto& renderer : renderers_) renderer->setObject(mesh_, texture->atlas, beta_mm_);
+  } else {
+    for (auto& renderer : renderers_) renderer->setObject(mesh_);
+  }
+  reset();
+}
+
+int TactileHand::sensorIndex(const std::string& name) const {
+  std::string names;
+  for (int s = 0; s < sensorCount(); ++s) {
+    if (sim_->sensor(s).name == name) return s;
+    names += (names.empty() ? "" : ", ") + sim_->sensor(s).name;
+  }
+  throw Error("sensor '" + name + "' is not in the hand; its sensors: " + names);
+}
+
+void TactileHand::checkSensor(int sensor) const {
+  if (sensor < 0 || sensor >= sensorCount()) {
+    throw Error("sensor index " + std::to_string(sensor) + " refused; valid: [0, " +
+                std::to_string(sensorCount() - 1) + "]");
+  }
+}
+
+void TactileHand::reset(const std::optional<Eigen::Isometry3d>& object_in_world) {
+  sim_->reset(object_in_world ? &*object_in_world : nullptr);
+  // Pad to whole frames: every frame stays on the physics clock's grid.
+  const std::int64_t ticks = sim_->ticks();
+  sim_->step(static_cast<int>((ticks_per_frame_ - ticks % ticks_per_frame_) % ticks_per_frame_));
+  episode_first_frame_ = frameIndex();
+  renderAll();
+}
+
+void TactileHand::stepPhysics(int frames) {
+  if (frames < 1 || frames > 100000) {
+    throw Error("step frames = " + std::to_string(frames) + " refused; valid: [1, 100000]");
+  }
+  sim_->step(frames * ticks_per_frame_);
+}
+
+void TactileHand::render(int sensor) {
+  checkSensor(sensor);
+  const std::int64_t frame =
+      options_.noise_per_episode ? frameIndex() - episode_first_frame_ : frameIndex();
+  const std::int64_t noise_seed = options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
+  frames_[sensor] = &renderers_[sensor]->render(objectInGel(sensor), noise_seed,
+                                                sim_->contact(sensor).normal_force_n);
+}
+
+void TactileHand::renderAll() {
+  for (int s = 0; s < sensorCount(); ++s) render(s);
+}
+
+Eigen::Isometry3d TactileHand::objectInGel(int sensor) const {
+  checkSensor(sensor);
+  return sim_->gelInWorld(sensor).inverse() * sim_->objectInWorld();
+}
+
+void TactileHand::step(int frames) {
+  stepPhysics(frames);
+  renderAll();
+}
+
+}  // namespace norm2tex
