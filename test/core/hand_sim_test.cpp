@@ -267,6 +267,27 @@ TEST(HandSim, TactosDigitConventionPutsEachGelOnItsMeshFacingTheOtherFinger) {
   EXPECT_EQ(countContaining(off.warnings(), "sensor 'digit_left': the gel surface lies"), 1);
 }
 
+
+TEST(HandSim, AnObjectBehindAGelIsNotPressedIntoIt) {
+  // A cube far behind the right gel, on its axis at the pads' height, weightless: the gel's
+  // pad outline covers it, but it is on the sensor's other side. Nothing touches it.
+  HandSimConfig config = wsgConfig();
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.3, 0.0, 0.168));
+  HandSim sim(config);
+  sim.resetObject(config.object_pose, false);
+  sim.step(500);
+  EXPECT_FALSE(sim.contact(0).in_contact || sim.contact(1).in_contact);
+  EXPECT_LT((sim.objectInWorld().translation() - config.object_pose.translation()).norm(), 1e-6);
+  // Just behind the surface (a press) it is pushed out, as a gel does.
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.024 - 0.015 + 0.0005, 0.0, 0.168));
+  HandSim pressed(config);
+  pressed.resetObject(config.object_pose, false);
+  pressed.step(1);
+  EXPECT_TRUE(pressed.contact(1).in_contact);
+  EXPECT_GT(pressed.contact(1).penetration_m, 0.0003);  // pushed back out, from 0.5 mm
+  EXPECT_LT(pressed.contact(1).penetration_m, 0.0005);
+}
+
 // ---------------------------------------------------------------- drives without contact --
 
 TEST(HandSim, TrajectoriesEndOnTheirTargetAndLimitsClamp) {

@@ -647,6 +647,19 @@ std::vector<std::vector<GelContactPoint>> HandSim::gelPoints(int sensor) const {
       points.push_back(gelContactPoints(part, body_in_gel, pad));
     }
   }
+  // A hand's gel can have the object behind it (behind its finger, across the palm), where
+  // GripperSim's two facing gels never do: a part reaching further behind the gel's surface
+  // than twice its thickness is on the sensor's other side, not pressed into its gel (a real
+  // press stops at the gel's thickness: too_deep).
+  const double behind = 2.0 * config_.gel_thickness_m;
+  for (std::vector<GelContactPoint>& part : points) {
+    for (const GelContactPoint& p : part) {
+      if (p.depth > behind) {
+        part.clear();
+        break;
+      }
+    }
+  }
   return points;
 }
 
