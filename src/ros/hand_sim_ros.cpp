@@ -355,7 +355,8 @@ bool HandSimRos::onReset(HandReset::Request& request, HandReset::Response& respo
     std::optional<Eigen::Isometry3d> pose;
     if (request.set_object_pose) pose = fromPoseMsg(request.object_pose, "object_pose");
     sim_->reset(pose ? &*pose : nullptr);
-    // A reset is a frame of its own on the physics clock: one tick, so stamps stay increasing.
+    // A reset is a frame of its own on the physics clock (one frame of ticks), so stamps keep
+    // increasing and the frame shows the object at rest where it was put.
     sim_->step(ticks_per_frame_);
     ++frame_;
     opening_command_ = 1.0;
