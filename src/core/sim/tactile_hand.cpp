@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "norm2tex/common/error.hpp"
+#include "sim/tactile_options.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/sim/tactile_gripper.hpp"
@@ -12,39 +13,12 @@
 namespace norm2tex {
 namespace {
 
-std::string text(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 /// Variants a hand keeps generated when it has a cache of its own.
 constexpr std::size_t kKeptVariants = 32;
 
 }  // namespace
 
-void validate(const TactileHandOptions& o) {
-  auto bad = [](const std::string& name, const std::string& value, const std::string& valid) {
-    throw Error("tactile hand option " + name + " = " + value + " is out of range; valid: " + valid);
-  };
-  if (!(o.physics_rate_hz >= 100.0 && o.physics_rate_hz <= 100000.0)) {
-    bad("physics_rate_hz", text(o.physics_rate_hz), "[100, 100000] Hz");
-  }
-  if (!(o.frame_rate_hz >= 1.0 && o.frame_rate_hz <= 1000.0 &&
-        o.frame_rate_hz <= o.physics_rate_hz)) {
-    bad("frame_rate_hz", text(o.frame_rate_hz), "[1, 1000] Hz and <= physics_rate_hz");
-  }
-  if (o.variant < 0) bad("variant", text(o.variant), ">= 0");
-  if (!(o.beta_mm < 0.0 || o.beta_mm <= 2.0)) {
-    bad("beta_mm", text(o.beta_mm), "[0, 2] mm, or < 0 for the material's");
-  }
-  if (!(o.friction < 0.0 || o.friction <= 5.0) || std::isnan(o.friction)) {
-    bad("friction", text(o.friction), "[0, 5], or < 0 for the material's");
-  }
-  if (o.material_config.empty() && o.beta_mm > 0.0) {
-    bad("beta_mm", text(o.beta_mm), "0 or < 0 without a material (nothing to texture)");
-  }
-}
+void validate(const TactileHandOptions& o) { detail::validateTactileOptions(o, "tactile hand option"); }
 
 TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
                          const TactileHandOptions& options,
