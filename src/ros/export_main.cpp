@@ -1,5 +1,7 @@
 // norm2tex_export: dataset_recorder bags -> PNG frames (raw and background-subtracted), depth
 // and labels.csv for training (see exportDataset).
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -42,15 +44,19 @@ int run(int argc, char** argv) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   double last_report = -1.0;
+  // On a terminal the progress line rewrites itself; in a log (a pipe, a file, Slurm's output)
+  // each report is a line of its own, not one enormous line of carriage returns.
+  const bool terminal = isatty(fileno(stderr)) != 0;
   const norm2tex::ExportSummary summary =
       norm2tex::exportDataset(args.positional(), options, [&](std::uint64_t done) {
         const double now = seconds();
         if (now - last_report < 0.5) return;  // a progress line at most twice a second
         last_report = now;
-        std::fprintf(stderr, "\rnorm2tex_export: %lu frames (%.0f/s)",
+        std::fprintf(stderr, terminal ? "\rnorm2tex_export: %lu frames (%.0f/s)"
+                                      : "norm2tex_export: %lu frames (%.0f/s)\n",
                      static_cast<unsigned long>(done), done / std::max(now, 1e-9));
       });
-  if (last_report >= 0.0) std::fprintf(stderr, "\n");
+  if (last_report >= 0.0 && terminal) std::fprintf(stderr, "\n");
   const double total = seconds();
   std::printf("norm2tex_export: %lu frames in %.2f s (%.0f frames/s) -> %s\n",
               static_cast<unsigned long>(summary.frames), total,

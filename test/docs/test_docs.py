@@ -475,6 +475,24 @@ class DocsTest(unittest.TestCase):
         errors = check_package()
         self.assertEqual(errors, [], "\n" + "\n".join(errors))
 
+    def test_scripts_help_says_whole_sentences(self):
+        # argparse's description from a docstring's first *line* cut `--help` mid-sentence
+        # ("reports its accuracy on"): a script takes its first paragraph, which ends a sentence.
+        scripts = os.path.join(ROOT, "scripts")
+        for name in sorted(os.listdir(scripts)):
+            path = os.path.join(scripts, name)
+            if not os.path.isfile(path):
+                continue
+            text = read(path)
+            if not text.startswith("#!/usr/bin/env python3") or "description=__doc__" not in text:
+                continue
+            self.assertFalse("__doc__.splitlines()[0]" in text,
+                             name + ": --help's description is the docstring's first line; use its first paragraph")
+            doc = re.search(r'^"""(.*?)"""', text.split("\n", 1)[1], re.S)
+            self.assertIsNotNone(doc, name)
+            first = doc.group(1).split("\n\n")[0].strip()
+            self.assertTrue(first.endswith("."), "%s: --help's description %r" % (name, first))
+
     def test_stop_reasons_are_listed_and_only_the_constants_are_written(self):
         reasons, literals = code_stop_reasons(os.path.join(ROOT, "src", "ros"))
         self.assertIn("last_frame", reasons)
