@@ -74,10 +74,17 @@ class DatasetTest(unittest.TestCase):
         run = subprocess.run([EXPORT] + cls.bags + ["-o", cls.export], capture_output=True,
                              text=True)
         assert run.returncode == 0, run.stdout + run.stderr
+        cls.export_stderr = run.stderr
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def test_progress_in_a_log_is_whole_lines(self):
+        # stderr is a pipe here, as in a log or Slurm's output: no carriage returns (they made one
+        # enormous line), each report a line of its own.
+        self.assertIn("norm2tex_export: ", self.export_stderr)
+        self.assertNotIn("\r", self.export_stderr)
 
     def test_exported_frames_load_in_batches_with_their_labels(self):
         data = ExportedDataset(self.export)
