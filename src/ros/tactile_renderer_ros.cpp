@@ -19,9 +19,11 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
+#include "norm2tex/materials/material_config.hpp"
 #include "params.hpp"
 
 namespace norm2tex {
@@ -64,6 +66,16 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& pnh) {
   }
   readParam(pnh, "variant", p.variant, 0);
   if (p.variant < 0) badParameter("variant", std::to_string(p.variant), ">= 0");
+  if (!p.material_config.empty()) {
+    // A material has variants 0 .. variant_count - 1 (its yaml): one past them is a typo, not
+    // a texture of that material.
+    const int count = loadMaterialConfig(p.material_config).variant_count;
+    if (p.variant >= count) {
+      badParameter("variant", std::to_string(p.variant),
+                   "[0, " + std::to_string(count - 1) + "] (" + p.material + "'s variant_count " +
+                       std::to_string(count) + ")");
+    }
+  }
   readParam(pnh, "material_seed", p.material_seed, 0);
   if (p.material_seed < 0) badParameter("material_seed", std::to_string(p.material_seed), ">= 0");
   readParam(pnh, "beta", p.beta, p.beta);

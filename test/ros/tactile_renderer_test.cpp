@@ -428,6 +428,8 @@ TEST(BadRendererInput, StartUpErrorsExitNonZeroNamingTheCause) {
       // Of the wrong type: roscpp's param() would take the default without a word.
       {"_rehearse_ms:=.nan", "~rehearse_ms = .nan is not valid; valid: a number"},
       {"_variant:=first", "~variant = first is not valid; valid: an integer"},
+      // The shipped materials have variants 0-23: 24 was drawn silently.
+      {"_material:=wood _variant:=24", "~variant = 24 is not valid; valid: [0, 23] (wood's variant_count 24)"},
       {"_publish_mask:=3", "~publish_mask = 3 is not valid; valid: true or false"},
   };
   for (const Case& c : cases) {
