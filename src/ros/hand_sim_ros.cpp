@@ -69,8 +69,8 @@ HandSimParams readHandSimParams(const ros::NodeHandle& pnh) {
     badParameter("friction", text(p.friction), "[0, 5], or < 0 for the material's");
   }
   readParam(pnh, "object_pose", p.object_pose, p.object_pose);
-  if (p.object_pose.size() != 6 ||
-      !std::all_of(p.object_pose.begin(), p.object_pose.end(), [](double v) { return std::isfinite(v); })) {
+  if (p.object_pose.size() != 6 || !std::all_of(p.object_pose.begin(), p.object_pose.end(),
+                                                [](double v) { return std::isfinite(v); })) {
     badParameter("object_pose", std::to_string(p.object_pose.size()) + " values",
                  "[x, y, z, roll, pitch, yaw], finite, m and rad");
   }
@@ -96,7 +96,8 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
     scene.object.name = std::filesystem::path(params_.mesh).stem().string();
   }
   if (params_.material != ros_params::kNoMaterial) {
-    const MaterialConfig material = loadMaterialConfig(materialConfigPath(params_.material, ", or none"));
+    const MaterialConfig material =
+        loadMaterialConfig(materialConfigPath(params_.material, ", or none"));
     scene.object.friction = material.friction;
     beta_mm_ = material.beta_mm;
   }
@@ -121,8 +122,9 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   owns_clock_ = ros::Time::isSimTime();
   if (params_.synchronous && !owns_clock_) {
-    throw Error("~mode = synchronous needs /use_sim_time = true (simulated time advances only "
-                "through ~step); set it before the nodes start, as hand_sim.launch does");
+    throw Error(
+        "~mode = synchronous needs /use_sim_time = true (simulated time advances only "
+        "through ~step); set it before the nodes start, as hand_sim.launch does");
   }
   if (!owns_clock_) time_base_ = ros::Time::now();
   // As Gazebo does: the simulator is the source of the robot's description.
@@ -159,7 +161,8 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
   ros::NodeHandle service_nh(private_nh_);
   service_nh.setCallbackQueue(&service_queue_);
   reset_srv_ = service_nh.advertiseService("reset", &HandSimRos::onReset, this);
-  if (params_.synchronous) step_srv_ = service_nh.advertiseService("step", &HandSimRos::onStep, this);
+  if (params_.synchronous)
+    step_srv_ = service_nh.advertiseService("step", &HandSimRos::onStep, this);
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   service_spinner_->start();
   {
@@ -167,12 +170,13 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
     if (!params_.synchronous || params_.renderers.empty()) publishFrame();
   }
   if (!params_.synchronous) clock_thread_ = std::thread(&HandSimRos::runClock, this);
-  ROS_INFO("hand_sim: %s mode, hand '%s' (%zu links, %zu actuated joints, %d sensors) from %s, "
-           "object '%s', physics %.0f Hz (%d ticks per %.1f Hz frame)",
-           params_.synchronous ? "synchronous" : "real-time", sim_->description().name.c_str(),
-           sim_->description().links.size(), sim_->actuatedJoints().size(), sim_->sensorCount(),
-           params_.hand.c_str(), config.object.mesh.c_str(), config.physics.rate_hz,
-           ticks_per_frame_, params_.frame_rate);
+  ROS_INFO(
+      "hand_sim: %s mode, hand '%s' (%zu links, %zu actuated joints, %d sensors) from %s, "
+      "object '%s', physics %.0f Hz (%d ticks per %.1f Hz frame)",
+      params_.synchronous ? "synchronous" : "real-time", sim_->description().name.c_str(),
+      sim_->description().links.size(), sim_->actuatedJoints().size(), sim_->sensorCount(),
+      params_.hand.c_str(), config.object.mesh.c_str(), config.physics.rate_hz, ticks_per_frame_,
+      params_.frame_rate);
 }
 
 HandSimRos::~HandSimRos() {
@@ -215,11 +219,12 @@ void HandSimRos::publishStaticTransforms() {
   };
   for (const HandJoint& joint : d.joints) {
     if (joint.movable()) continue;
-    transforms.push_back(stamped(d.links[joint.parent_link].name, d.links[joint.child_link].name,
-                                 joint.origin));
+    transforms.push_back(
+        stamped(d.links[joint.parent_link].name, d.links[joint.child_link].name, joint.origin));
   }
   for (int s = 0; s < sim_->sensorCount(); ++s) {
-    transforms.push_back(stamped(sim_->sensor(s).link, sim_->sensor(s).name + "_gel", sim_->gelInLink(s)));
+    transforms.push_back(
+        stamped(sim_->sensor(s).link, sim_->sensor(s).name + "_gel", sim_->gelInLink(s)));
   }
   static_tf_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
   static_tf_->sendTransform(transforms);
@@ -248,9 +253,9 @@ std::uint32_t HandSimRos::publishFrame() {
   tf.transforms.push_back(stamped("world", d.links[0].name, sim_->linkInWorld(0)));
   for (const HandJoint& joint : d.joints) {
     if (!joint.movable()) continue;
-    tf.transforms.push_back(stamped(d.links[joint.parent_link].name, d.links[joint.child_link].name,
-                                    sim_->linkInWorld(joint.parent_link).inverse() *
-                                        sim_->linkInWorld(joint.child_link)));
+    tf.transforms.push_back(stamped(
+        d.links[joint.parent_link].name, d.links[joint.child_link].name,
+        sim_->linkInWorld(joint.parent_link).inverse() * sim_->linkInWorld(joint.child_link)));
   }
   tf.transforms.push_back(stamped("world", "object", sim_->objectInWorld()));
   tf_pub_.publish(tf);
@@ -272,7 +277,8 @@ std::uint32_t HandSimRos::publishFrame() {
     header.frame_id = sim_->sensor(s).name + "_gel";
     const GelContactState& state = sim_->contact(s);
     const ContactPatch patch = meters_[s]->measure(sim_->object().mesh, state.object_in_gel);
-    contact_pubs_[s].publish(ros_conversions::toContactMsg(header, sim_->sensor(s).name, state, patch));
+    contact_pubs_[s].publish(
+        ros_conversions::toContactMsg(header, sim_->sensor(s).name, state, patch));
   }
 
   SimFrame frame;
@@ -340,7 +346,8 @@ void HandSimRos::onGripperCommand(const GripperCommand::ConstPtr& msg) {
       if (!(std::abs(msg->opening) <= 1.0)) throw Error("a DELTA opening must be within [-1, 1]");
       opening = std::clamp(opening_command_ + msg->opening, 0.0, 1.0);
     } else if (msg->mode != GripperCommand::ABSOLUTE) {
-      throw Error("mode " + std::to_string(msg->mode) + " is not valid; valid: 0 (ABSOLUTE), 1 (DELTA)");
+      throw Error("mode " + std::to_string(msg->mode) +
+                  " is not valid; valid: 0 (ABSOLUTE), 1 (DELTA)");
     }
     sim_->setOpening(opening);
     opening_command_ = opening;
@@ -379,7 +386,8 @@ bool HandSimRos::onStep(HandStep::Request& request, HandStep::Response& response
   std::lock_guard<std::mutex> lock(mutex_);
   response.success = false;
   if (request.frames < 1 || request.frames > 100000) {
-    response.message = "~step frames = " + std::to_string(request.frames) + " refused; valid: [1, 100000]";
+    response.message =
+        "~step frames = " + std::to_string(request.frames) + " refused; valid: [1, 100000]";
     ROS_WARN("hand_sim: %s", response.message.c_str());
     return true;
   }

@@ -26,17 +26,17 @@ namespace norm2tex {
 
 /// Validated private parameters of hand_sim (docs/ros.md, "hand_sim").
 struct HandSimParams {
-  bool synchronous = false;       ///< ~mode: "real_time" | "synchronous"
-  std::string hand;               ///< ~hand: the hand yaml (docs/hands.md)
-  std::string scene;              ///< ~scene: scene yaml for the object, physics and gel law
-  std::string mesh;               ///< ~mesh: replaces the scene's object mesh when set
-  double scale = 1.0;             ///< ~scale of ~mesh
-  std::string sensor;             ///< ~sensor: sensor yaml (gel pad and thickness)
-  std::string material;           ///< ~material: its friction; "none": ~friction
-  double friction = -1.0;         ///< ~friction; < 0: the material's
+  bool synchronous = false;  ///< ~mode: "real_time" | "synchronous"
+  std::string hand;          ///< ~hand: the hand yaml (docs/hands.md)
+  std::string scene;         ///< ~scene: scene yaml for the object, physics and gel law
+  std::string mesh;          ///< ~mesh: replaces the scene's object mesh when set
+  double scale = 1.0;        ///< ~scale of ~mesh
+  std::string sensor;        ///< ~sensor: sensor yaml (gel pad and thickness)
+  std::string material;      ///< ~material: its friction; "none": ~friction
+  double friction = -1.0;    ///< ~friction; < 0: the material's
   std::vector<double> object_pose{0.0, 0.0, 0.1, 0.0, 0.0, 0.0};  ///< ~object_pose [x y z r p y]
-  double physics_rate = 1000.0;   ///< ~physics_rate [Hz], whole ticks per frame
-  double frame_rate = 60.0;       ///< ~frame_rate [Hz]
+  double physics_rate = 1000.0;  ///< ~physics_rate [Hz], whole ticks per frame
+  double frame_rate = 60.0;      ///< ~frame_rate [Hz]
   /// ~renderers: the sensors whose FrameRendered each synchronous frame waits for; absent: every
   /// sensor of the hand yaml.
   std::vector<std::string> renderers;

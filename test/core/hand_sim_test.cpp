@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "norm2tex/sim/hand_config.hpp"
-#include "norm2tex/sim/hand_description.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
+#include "norm2tex/sim/hand_config.hpp"
+#include "norm2tex/sim/hand_description.hpp"
 #include "norm2tex/sim/hand_sim.hpp"
 #include "test_helpers.hpp"
 
@@ -82,9 +82,11 @@ TEST(HandDescription, LoadsTactosWsg50AsItIsWithAWordOnWhatItChanged) {
   EXPECT_NE(hand.urdf_xml.find("<robot name=\"wsg50_digit\">"), std::string::npos);
   // For /robot_description: every mesh as an absolute file:// URI, nothing else changed.
   EXPECT_EQ(hand.resolved_urdf_xml.find("package://"), std::string::npos);
-  EXPECT_NE(hand.resolved_urdf_xml.find("filename=\"file://" + kRobots + "/wsg50/DIGIT-WSG-50-V1.STL\""),
+  EXPECT_NE(
+      hand.resolved_urdf_xml.find("filename=\"file://" + kRobots + "/wsg50/DIGIT-WSG-50-V1.STL\""),
+      std::string::npos);
+  EXPECT_NE(hand.resolved_urdf_xml.find("<limit lower=\"-0.055\" upper=\"-0.0027\""),
             std::string::npos);
-  EXPECT_NE(hand.resolved_urdf_xml.find("<limit lower=\"-0.055\" upper=\"-0.0027\""), std::string::npos);
 }
 
 TEST(HandDescription, APlausibleInertiaIsKept) {
@@ -173,8 +175,9 @@ TEST(HandDescription, RootLinkKeepsOnlyTheHandOfAWholeRobot) {
   const HandJoint& b = hand.joints[hand.jointIndex("finger_b_joint")];
   EXPECT_EQ(b.mimic_master, hand.jointIndex("finger_a_joint"));
   EXPECT_DOUBLE_EQ(b.mimic_multiplier, -1.0);
-  test::expectError([&] { loadHandDescription(dir.path("arm.urdf"), PackagePaths{}, "wrist_link"); },
-                    {"root_link 'wrist_link'", "not a link"});
+  test::expectError(
+      [&] { loadHandDescription(dir.path("arm.urdf"), PackagePaths{}, "wrist_link"); },
+      {"root_link 'wrist_link'", "not a link"});
 }
 
 TEST(HandDescription, BadDescriptionsAreClearErrors) {
@@ -215,28 +218,36 @@ TEST(HandConfig, ReadsTheYamlAndRefusesWhatIsNotThere) {
 
   test::ScratchDirectory dir;
   const std::string urdf = kRobots + "/wsg50/wsg50_digit.urdf";
-  write(dir.path("typo.yaml"), "hand: {urdf: " + urdf + ", base_pos: [0,0,0,0,0,0]}\nsensors: [{name: a, link: b}]\n");
+  write(dir.path("typo.yaml"),
+        "hand: {urdf: " + urdf + ", base_pos: [0,0,0,0,0,0]}\nsensors: [{name: a, link: b}]\n");
   test::expectError([&] { loadHandConfig(dir.path("typo.yaml")); },
                     {"typo.yaml", "hand.base_pos is not a known key", "base_pose"});
   write(dir.path("nosensors.yaml"), "hand: {urdf: " + urdf + "}\n");
   test::expectError([&] { loadHandConfig(dir.path("nosensors.yaml")); }, {"sensors is required"});
-  write(dir.path("gel.yaml"), "hand: {urdf: " + urdf + "}\nsensors: [{name: a, link: b, gel: [0, 0, 0]}]\n");
-  test::expectError([&] { loadHandConfig(dir.path("gel.yaml")); }, {"sensors[0].gel needs 6 numbers"});
+  write(dir.path("gel.yaml"),
+        "hand: {urdf: " + urdf + "}\nsensors: [{name: a, link: b, gel: [0, 0, 0]}]\n");
+  test::expectError([&] { loadHandConfig(dir.path("gel.yaml")); },
+                    {"sensors[0].gel needs 6 numbers"});
   write(dir.path("name.yaml"), "hand: {urdf: " + urdf + "}\nsensors: [{name: a/b, link: b}]\n");
-  test::expectError([&] { loadHandConfig(dir.path("name.yaml")); }, {"'a/b' is not a valid ROS name"});
-  write(dir.path("drive.yaml"), "hand: {urdf: " + urdf + "}\nsensors: [{name: a, link: b}]\njoints: {j: {effort: -1}}\n");
-  test::expectError([&] { loadHandConfig(dir.path("drive.yaml")); }, {"joints.j.effort", "valid: > 0"});
+  test::expectError([&] { loadHandConfig(dir.path("name.yaml")); },
+                    {"'a/b' is not a valid ROS name"});
+  write(dir.path("drive.yaml"),
+        "hand: {urdf: " + urdf + "}\nsensors: [{name: a, link: b}]\njoints: {j: {effort: -1}}\n");
+  test::expectError([&] { loadHandConfig(dir.path("drive.yaml")); },
+                    {"joints.j.effort", "valid: > 0"});
 }
 
 TEST(HandSim, RefusesASensorOnALinkNotInTheHandAndDrivesWithoutLimits) {
   HandSimConfig config = wsgConfig();
   config.hand.sensors[1].link = "finger_right_tipp";
-  test::expectError([&] { HandSim sim(config); },
-                    {"sensor 'digit_right'", "'finger_right_tipp' is not in the hand", "finger_right_tip"});
+  test::expectError(
+      [&] { HandSim sim(config); },
+      {"sensor 'digit_right'", "'finger_right_tipp' is not in the hand", "finger_right_tip"});
   HandSimConfig allegro;
   allegro.hand = loadHandConfig(kAllegroYaml);
   allegro.hand.default_drive = JointDriveOptions{};
-  test::expectError([&] { HandSim sim(allegro); }, {"joint 'joint_", "has no effort limit (the URDF gives 0)", "joints.default"});
+  test::expectError([&] { HandSim sim(allegro); },
+                    {"joint 'joint_", "has no effort limit (the URDF gives 0)", "joints.default"});
 }
 
 // ---------------------------------------------------------------------------- the gel mount --
@@ -266,7 +277,6 @@ TEST(HandSim, TactosDigitConventionPutsEachGelOnItsMeshFacingTheOtherFinger) {
   HandSim off(config);
   EXPECT_EQ(countContaining(off.warnings(), "sensor 'digit_left': the gel surface lies"), 1);
 }
-
 
 TEST(HandSim, AnObjectBehindAGelIsNotPressedIntoIt) {
   // A cube far behind the right gel, on its axis at the pads' height, weightless: the gel's
@@ -301,8 +311,8 @@ TEST(HandSim, TrajectoriesEndOnTheirTargetAndLimitsClamp) {
   EXPECT_TRUE(sim.setTrajectory(t).empty());
   // Halfway through the first segment the target is halfway from the start.
   sim.step(250);
-  EXPECT_NEAR(sim.jointTargets()[sim.description().jointIndex("base_joint_gripper_left")],
-              -0.0425, 1e-9);
+  EXPECT_NEAR(sim.jointTargets()[sim.description().jointIndex("base_joint_gripper_left")], -0.0425,
+              1e-9);
   sim.step(1250);
   EXPECT_NEAR(sim.jointPosition("base_joint_gripper_left"), -0.030, 1e-7);
   EXPECT_NEAR(sim.jointPosition("base_joint_gripper_right"), 0.050, 1e-7);
@@ -314,15 +324,18 @@ TEST(HandSim, TrajectoriesEndOnTheirTargetAndLimitsClamp) {
   const auto clamped = sim.setJointTargets({"base_joint_gripper_left"}, {-0.2});
   ASSERT_EQ(clamped.size(), 1u);
   EXPECT_EQ(clamped[0], "base_joint_gripper_left");
-  EXPECT_DOUBLE_EQ(sim.jointTargets()[sim.description().jointIndex("base_joint_gripper_left")], -0.055);
+  EXPECT_DOUBLE_EQ(sim.jointTargets()[sim.description().jointIndex("base_joint_gripper_left")],
+                   -0.055);
   // Refused, with the reason, nothing changed.
   test::expectError([&] { sim.setJointTargets({"guide_joint_finger_left"}, {0.0}); }, {"is fixed"});
   test::expectError([&] { sim.setJointTargets({"thumb"}, {0.0}); },
                     {"unknown joint 'thumb'", "base_joint_gripper_left"});
-  test::expectError([&] { sim.setJointTargets({"base_joint_gripper_left"}, {NAN}); }, {"not finite"});
+  test::expectError([&] { sim.setJointTargets({"base_joint_gripper_left"}, {NAN}); },
+                    {"not finite"});
   t.times_s = {0.5, 0.5};
   test::expectError([&] { sim.setTrajectory(t); }, {"point 1", "not after the previous point"});
-  EXPECT_DOUBLE_EQ(sim.jointTargets()[sim.description().jointIndex("base_joint_gripper_left")], -0.055);
+  EXPECT_DOUBLE_EQ(sim.jointTargets()[sim.description().jointIndex("base_joint_gripper_left")],
+                   -0.055);
 }
 
 TEST(HandSim, AllegroJointsTrackWithinAHalfDegree) {
@@ -351,14 +364,16 @@ TEST(HandSim, AllegroJointsTrackWithinAHalfDegree) {
 TEST(HandSim, MimicJointsFollowTheirMaster) {
   test::ScratchDirectory dir;
   write(dir.path("arm.urdf"), kArmWithHand);
-  write(dir.path("hand.yaml"), "hand: {urdf: arm.urdf, root_link: palm, base_pose: [0, 0, 0.3, 0, 0, 0]}\n"
-                               "sensors: [{name: digit_a, link: finger_a, gel: [0.005, 0, 0.03, 0, 0, 0]}]\n");
+  write(dir.path("hand.yaml"),
+        "hand: {urdf: arm.urdf, root_link: palm, base_pose: [0, 0, 0.3, 0, 0, 0]}\n"
+        "sensors: [{name: digit_a, link: finger_a, gel: [0.005, 0, 0.03, 0, 0, 0]}]\n");
   HandSimConfig config;
   config.hand = loadHandConfig(dir.path("hand.yaml"));
   config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.5, 0.0, 0.015));
   HandSim sim(config);
   EXPECT_EQ(sim.actuatedJoints(), std::vector<std::string>{"finger_a_joint"});
-  test::expectError([&] { sim.setJointTargets({"finger_b_joint"}, {0.0}); }, {"mimics 'finger_a_joint'"});
+  test::expectError([&] { sim.setJointTargets({"finger_b_joint"}, {0.0}); },
+                    {"mimics 'finger_a_joint'"});
   sim.setJointTargets({"finger_a_joint"}, {0.02});
   sim.step(500);
   EXPECT_NEAR(sim.jointPosition("finger_a_joint"), 0.02, 1e-9);
@@ -366,7 +381,9 @@ TEST(HandSim, MimicJointsFollowTheirMaster) {
   // The fingers are 80 - 2 x 20 = 40 mm apart.
   const HandDescription& d = sim.description();
   EXPECT_NEAR((sim.linkInWorld(d.linkIndex("finger_b")).translation() -
-               sim.linkInWorld(d.linkIndex("finger_a")).translation()).norm(), 0.040, 1e-9);
+               sim.linkInWorld(d.linkIndex("finger_a")).translation())
+                  .norm(),
+              0.040, 1e-9);
 }
 
 // -------------------------------------------------------------------------------- grasps --
@@ -406,7 +423,8 @@ void expectHeldThenDropped(HandSim& sim, double initial_opening, double object_h
               sim.contact(0).penetration_m * 1e3, sim.contact(1).penetration_m * 1e3,
               sim.contact(0).normal_force_n, sim.contact(1).normal_force_n);
   EXPECT_LT((later.translation() - held.translation()).norm(), 0.1e-3);
-  EXPECT_LT(Eigen::AngleAxisd(held.linear().transpose() * later.linear()).angle(), 0.1 * M_PI / 180);
+  EXPECT_LT(Eigen::AngleAxisd(held.linear().transpose() * later.linear()).angle(),
+            0.1 * M_PI / 180);
   EXPECT_TRUE(sim.contact(0).in_contact && sim.contact(1).in_contact);
   sim.setOpening(initial_opening);
   sim.step(1500);
@@ -420,7 +438,8 @@ TEST(HandSimGrasp, Wsg50HoldsTheCubeAtOneMillimetreOnBothGelsThenDropsIt) {
   EXPECT_NEAR(grasp.left_mm, 1.0, 0.05);
   EXPECT_NEAR(grasp.right_mm, 1.0, 0.05);
   // The force each gel carries is the drive's effort.
-  EXPECT_NEAR(sim.contact(0).normal_force_n, sim.jointEffort(sim.description().jointIndex("base_joint_gripper_left")),
+  EXPECT_NEAR(sim.contact(0).normal_force_n,
+              sim.jointEffort(sim.description().jointIndex("base_joint_gripper_left")),
               0.05 * sim.contact(0).normal_force_n);
   expectHeldThenDropped(sim, (0.040 - 0.016) / (0.055 - 0.016), 0.015);
 }
@@ -432,21 +451,24 @@ TEST(HandSimGrasp, Wsg50HoldsASixtyMillimetreCylinder) {
   const int n = 48;
   for (int ring = 0; ring < 2; ++ring) {
     for (int i = 0; i < n; ++i) {
-      obj << "v " << 30 * std::cos(2 * M_PI * i / n) << " " << 30 * std::sin(2 * M_PI * i / n) << " "
-          << (ring ? 20 : -20) << "\n";
+      obj << "v " << 30 * std::cos(2 * M_PI * i / n) << " " << 30 * std::sin(2 * M_PI * i / n)
+          << " " << (ring ? 20 : -20) << "\n";
     }
   }
   for (int i = 0; i < n; ++i) {
     const int a = i + 1, b = (i + 1) % n + 1;
-    obj << "f " << a << " " << b << " " << b + n << "\nf " << a << " " << b + n << " " << a + n << "\n";
+    obj << "f " << a << " " << b << " " << b + n << "\nf " << a << " " << b + n << " " << a + n
+        << "\n";
   }
   for (int i = 1; i + 1 < n; ++i) {
-    obj << "f 1 " << i + 2 << " " << i + 1 << "\nf " << n + 1 << " " << n + i + 1 << " " << n + i + 2 << "\n";
+    obj << "f 1 " << i + 2 << " " << i + 1 << "\nf " << n + 1 << " " << n + i + 1 << " "
+        << n + i + 2 << "\n";
   }
   obj.close();
   HandSimConfig config = wsgGraspConfig(dir.path("cylinder.obj"), 1e-3);
   config.object.scale = 1e-3;
-  config.hand.initial_positions = {{"base_joint_gripper_left", -0.050}, {"base_joint_gripper_right", 0.050}};
+  config.hand.initial_positions = {{"base_joint_gripper_left", -0.050},
+                                   {"base_joint_gripper_right", 0.050}};
   HandSim sim(config);
   EXPECT_EQ(sim.collision().kind, "hull");
   const Grasp grasp = graspWithTheWsg(sim);
@@ -468,8 +490,8 @@ TEST(HandSimGrasp, AllegroClosesFourFingersOnASphereInItsPalmByATrajectory) {
   sim.step(500);  // the ball settles on the palm
   EXPECT_NEAR(sim.objectInWorld().translation().z(), 0.1 + 0.0111 + 0.045, 1e-3);
   JointTrajectoryCommand close;
-  close.joint_names = {"joint_1.0", "joint_2.0", "joint_3.0", "joint_5.0", "joint_6.0",
-                       "joint_7.0", "joint_9.0", "joint_10.0", "joint_11.0", "joint_12.0",
+  close.joint_names = {"joint_1.0",  "joint_2.0",  "joint_3.0",  "joint_5.0",  "joint_6.0",
+                       "joint_7.0",  "joint_9.0",  "joint_10.0", "joint_11.0", "joint_12.0",
                        "joint_13.0", "joint_14.0", "joint_15.0"};
   close.times_s = {2.0};
   close.positions = {{1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.39, 1.15, 1.15, 1.15}};
@@ -510,8 +532,10 @@ TEST(HandSimGrasp, TheBuiltInGripperAsAUrdfHoldsTheCubeAsGripperSimDoes) {
   config.hand.drives["finger_left_joint"].effort = 2.0 * scene.gel_law.force(1e-3);
   config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 0.2));
   HandSim hand(config);
-  EXPECT_TRUE((hand.gelInWorld(0).linear() - gripper.gelInWorld(Finger::kLeft).linear()).isZero(1e-12));
-  EXPECT_TRUE((hand.gelInWorld(1).linear() - gripper.gelInWorld(Finger::kRight).linear()).isZero(1e-12));
+  EXPECT_TRUE(
+      (hand.gelInWorld(0).linear() - gripper.gelInWorld(Finger::kLeft).linear()).isZero(1e-12));
+  EXPECT_TRUE(
+      (hand.gelInWorld(1).linear() - gripper.gelInWorld(Finger::kRight).linear()).isZero(1e-12));
   EXPECT_NEAR(hand.gelInWorld(0).translation().y(), 0.020, 1e-12);
   hand.resetObject(config.object_pose, false);
   hand.setOpening(0.0);

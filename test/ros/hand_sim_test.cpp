@@ -7,11 +7,11 @@
 #include <map>
 #include <string>
 
+#include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <geometry_msgs/PoseStamped.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/JointState.h>
 #include <tf2_ros/buffer.h>
@@ -40,14 +40,16 @@ struct Hand {
       "/digit_right/image_raw", 1000, [this](const auto&) { ++images["digit_right"]; });
   ros::Subscriber joint_sub = nh.subscribe<sensor_msgs::JointState>(
       "/joint_states", 10, [this](const auto& m) { joints = m; });
-  ros::Publisher trajectory = nh.advertise<trajectory_msgs::JointTrajectory>("/hand_sim/joint_command", 1);
+  ros::Publisher trajectory =
+      nh.advertise<trajectory_msgs::JointTrajectory>("/hand_sim/joint_command", 1);
   ros::ServiceClient step = nh.serviceClient<norm2tex::HandStep>("/hand_sim/step");
   ros::ServiceClient reset = nh.serviceClient<norm2tex::HandReset>("/hand_sim/reset");
 
   Hand() {
     // The renderers bake the wood texture first: the services come once hand_sim is up.
     EXPECT_TRUE(step.waitForExistence(ros::Duration(120.0)));
-    EXPECT_TRUE(waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60.0));
+    EXPECT_TRUE(
+        waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60.0));
   }
   norm2tex::HandStep::Response stepFrames(unsigned frames) {
     norm2tex::HandStep srv;
@@ -76,21 +78,26 @@ TEST(HandSimRealTime, FourSensorsPublishAnImageOfEveryFrameAtSixtyHertz) {
   // Real time: the stamps of each sensor's images must be the frames' grid, 1/60 s apart, with
   // none missing, for two seconds of frames (counted, not timed).
   ros::NodeHandle nh;
-  const std::vector<std::string> sensors = {"digit_index", "digit_middle", "digit_ring", "digit_thumb"};
+  const std::vector<std::string> sensors = {"digit_index", "digit_middle", "digit_ring",
+                                            "digit_thumb"};
   std::map<std::string, std::vector<ros::Time>> stamps;
   std::vector<ros::Subscriber> subs;
   for (const std::string& sensor : sensors) {
-    subs.push_back(nh.subscribe<sensor_msgs::Image>(
-        "/" + sensor + "/image_raw", 1000,
-        [&stamps, sensor](const sensor_msgs::Image::ConstPtr& m) { stamps[sensor].push_back(m->header.stamp); }));
+    subs.push_back(
+        nh.subscribe<sensor_msgs::Image>("/" + sensor + "/image_raw", 1000,
+                                         [&stamps, sensor](const sensor_msgs::Image::ConstPtr& m) {
+                                           stamps[sensor].push_back(m->header.stamp);
+                                         }));
   }
   constexpr size_t kFrames = 120;
-  ASSERT_TRUE(waitFor([&] {
-    for (const std::string& sensor : sensors) {
-      if (stamps[sensor].size() < kFrames) return false;
-    }
-    return true;
-  }, 60.0));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const std::string& sensor : sensors) {
+          if (stamps[sensor].size() < kFrames) return false;
+        }
+        return true;
+      },
+      60.0));
   for (const std::string& sensor : sensors) {
     const std::vector<ros::Time>& s = stamps[sensor];
     int gaps = 0;
@@ -104,7 +111,8 @@ TEST(HandSimRealTime, FourSensorsPublishAnImageOfEveryFrameAtSixtyHertz) {
   ros::Time first;
   for (const std::string& sensor : sensors) first = std::max(first, stamps[sensor].front());
   for (const std::string& sensor : sensors) {
-    EXPECT_NE(std::find(stamps[sensor].begin(), stamps[sensor].end(), first), stamps[sensor].end()) << sensor;
+    EXPECT_NE(std::find(stamps[sensor].begin(), stamps[sensor].end(), first), stamps[sensor].end())
+        << sensor;
   }
 }
 
@@ -155,13 +163,15 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   const auto first = hand.stepFrames(30);
   EXPECT_EQ(first.missing_images, 0u);
   // Each ~step returns once every image of its frames is out: exactly 30 per sensor.
-  ASSERT_TRUE(waitFor([&] { return hand.images["digit_left"] >= 30 && hand.images["digit_right"] >= 30; }, 10.0));
+  ASSERT_TRUE(waitFor(
+      [&] { return hand.images["digit_left"] >= 30 && hand.images["digit_right"] >= 30; }, 10.0));
   EXPECT_EQ(hand.images["digit_left"], 30);
   EXPECT_EQ(hand.images["digit_right"], 30);
   ASSERT_EQ(first.sensors, (std::vector<std::string>{"digit_left", "digit_right"}));
   EXPECT_FALSE(first.in_contact[0] || first.in_contact[1]);
   EXPECT_TRUE(hand.buffer.canTransform("world", "digit_left_gel", first.stamp, ros::Duration(5.0)));
-  EXPECT_TRUE(hand.buffer.canTransform("finger_right_tip", "digit_right_gel", ros::Time(0), ros::Duration(5.0)));
+  EXPECT_TRUE(hand.buffer.canTransform("finger_right_tip", "digit_right_gel", ros::Time(0),
+                                       ros::Duration(5.0)));
   ASSERT_TRUE(waitFor([&] { return hand.joints != nullptr; }, 5.0));
   EXPECT_EQ(hand.joints->name.size(), 2u);
 
@@ -172,7 +182,8 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   EXPECT_NEAR(held.normal_force[0], 10.0, 0.5);
   EXPECT_NEAR(held.normal_force[1], 10.0, 0.5);
   EXPECT_GT(held.penetration[0], 0.5e-3);
-  ASSERT_TRUE(waitFor([&] { return hand.images["digit_left"] == 180 && hand.images["digit_right"] == 180; }, 10.0));
+  ASSERT_TRUE(waitFor(
+      [&] { return hand.images["digit_left"] == 180 && hand.images["digit_right"] == 180; }, 10.0));
   // The gel frame sees the cube's face at the indentation the physics reports.
   const geometry_msgs::TransformStamped cube =
       hand.buffer.lookupTransform("digit_left_gel", "object", held.stamp, ros::Duration(5.0));
@@ -193,15 +204,18 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   // frame lifts it, and the cube with it.
   ros::Publisher gripper = hand.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 1);
   ros::Publisher base = hand.nh.advertise<geometry_msgs::PoseStamped>("/hand_sim/base_pose", 100);
-  ASSERT_TRUE(waitFor([&] { return gripper.getNumSubscribers() > 0 && base.getNumSubscribers() > 0; }, 30.0));
+  ASSERT_TRUE(waitFor(
+      [&] { return gripper.getNumSubscribers() > 0 && base.getNumSubscribers() > 0; }, 30.0));
   norm2tex::GripperCommand command;
   command.mode = norm2tex::GripperCommand::ABSOLUTE;
   command.opening = 0.0;
   gripper.publish(command);
   // The command is taken before the next ~step: hand_sim handles it as it arrives.
-  ASSERT_TRUE(waitFor([&] {
-    return hand.stepFrames(1).in_contact == std::vector<std::uint8_t>{1, 1};
-  }, 30.0));
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return hand.stepFrames(1).in_contact == std::vector<std::uint8_t>{1, 1};
+      },
+      30.0));
   hand.stepFrames(60);
   geometry_msgs::PoseStamped pose;
   pose.header.frame_id = "world";

@@ -18,7 +18,7 @@ struct SensorMount {
   /// its +x, the gel's centre on its surface, 20 mm wide along y and 30 mm tall along z.
   /// Default: TACTO's DIGIT link, (0.022, 0, 0.015) with no rotation.
   Eigen::Isometry3d digit_in_link = Eigen::Isometry3d(Eigen::Translation3d(0.022, 0.0, 0.015));
-  bool gel_given = false;  ///< the yaml gave `gel` (else TACTO's default)
+  bool gel_given = false;   ///< the yaml gave `gel` (else TACTO's default)
   std::string sensor_yaml;  ///< optional sensor model (resolved path), empty: the shipped one
 };
 
@@ -31,8 +31,8 @@ struct JointDriveOptions {
 
 /// The hand yaml (docs/hands.md): the URDF, where the hand stands, its DIGITs, its drives.
 struct HandConfig {
-  std::string urdf_path;   ///< resolved against the yaml's folder
-  std::string root_link;   ///< empty: the URDF's root
+  std::string urdf_path;  ///< resolved against the yaml's folder
+  std::string root_link;  ///< empty: the URDF's root
   /// The root link's pose in the world (yaml: [x, y, z, roll, pitch, yaw], m and rad).
   Eigen::Isometry3d base_pose = Eigen::Isometry3d::Identity();
   PackagePaths package_paths;  ///< hand.package_paths (relative to the yaml) + ROS_PACKAGE_PATH

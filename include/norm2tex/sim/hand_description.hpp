@@ -94,10 +94,10 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
 
 /// Loads a hand from URDF with urdfdom. `root_link` (optional) keeps only that link's subtree
 /// (a whole robot's URDF with the hand at its tip). Mesh collision files are resolved and loaded
-/// (TexturedMesh::load). Messy files are accepted with a warning each: a tag given twice in a joint or link
-/// (the first is used, as urdfdom does), `<gazebo>`, `<transmission>` and other unknown blocks
-/// (ignored without a word), and an inertia that is not a solid's of the link's mass within its
-/// collision geometry's bounding box (principal moments outside [I_min / 10, 10 I_max] of that
+/// (TexturedMesh::load). Messy files are accepted with a warning each: a tag given twice in a joint
+/// or link (the first is used, as urdfdom does), `<gazebo>`, `<transmission>` and other unknown
+/// blocks (ignored without a word), and an inertia that is not a solid's of the link's mass within
+/// its collision geometry's bounding box (principal moments outside [I_min / 10, 10 I_max] of that
 /// box's, or violating the triangle inequality) is replaced by the bounding box's inertia.
 /// Throws Error for: an unreadable file, XML that is not well formed (with its line), a URDF
 /// urdfdom refuses (its reason), floating or planar joints, an unknown root_link, a mimic joint

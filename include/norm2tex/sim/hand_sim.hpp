@@ -34,8 +34,8 @@ struct HandSimConfig {
 /// positions at times from its start.
 struct JointTrajectoryCommand {
   std::vector<std::string> joint_names;
-  std::vector<double> times_s;                  ///< time_from_start of each point, increasing
-  std::vector<std::vector<double>> positions;   ///< per point, one per joint name
+  std::vector<double> times_s;                 ///< time_from_start of each point, increasing
+  std::vector<std::vector<double>> positions;  ///< per point, one per joint name
 };
 
 /// Where a mounted gel stands against its link's collision mesh (what loading checked).
@@ -151,7 +151,7 @@ class HandSim {
   };
   struct Trajectory {
     std::vector<int> joints;
-    std::vector<double> start;            ///< targets when it was set
+    std::vector<double> start;  ///< targets when it was set
     std::vector<double> times_s;
     std::vector<std::vector<double>> positions;
     double start_s = 0.0;
@@ -194,7 +194,8 @@ class HandSim {
   std::vector<std::vector<int>> link_joints_;
   Eigen::Isometry3d base_pose_ = Eigen::Isometry3d::Identity();
   /// A base motion in progress: from, to, and its ticks done / in all.
-  Eigen::Isometry3d base_from_ = Eigen::Isometry3d::Identity(), base_to_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d base_from_ = Eigen::Isometry3d::Identity(),
+                    base_to_ = Eigen::Isometry3d::Identity();
   int base_tick_ = 0, base_ticks_ = 0;
   Trajectory trajectory_;
   bool following_trajectory_ = false;

@@ -67,8 +67,8 @@ Eigen::Isometry3d poseFromXyzRpy(const std::vector<double>& v) {
 Eigen::Isometry3d gelInDigit() {
   // Columns: the gel's x (image right), y (image down), z (out of the gel), in the DIGIT frame.
   Eigen::Matrix3d r;
-  r << 0, 0, 1,   //
-      -1, 0, 0,   //
+  r << 0, 0, 1,  //
+      -1, 0, 0,  //
       0, -1, 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = r;
@@ -92,9 +92,11 @@ HandConfig loadHandConfig(const std::string& yaml_path) {
     requireKnownKeys(hand, "hand", {"urdf", "root_link", "base_pose", "package_paths"});
     c.urdf_path = resolvePath(hand["urdf"].as<std::string>(), base);
     if (hand["root_link"]) c.root_link = hand["root_link"].as<std::string>();
-    if (hand["base_pose"]) c.base_pose = poseFromXyzRpy(readNumbers(hand["base_pose"], "hand.base_pose", 6));
+    if (hand["base_pose"])
+      c.base_pose = poseFromXyzRpy(readNumbers(hand["base_pose"], "hand.base_pose", 6));
     if (hand["package_paths"]) {
-      if (!hand["package_paths"].IsMap()) throw Error("hand.package_paths must map package names to folders");
+      if (!hand["package_paths"].IsMap())
+        throw Error("hand.package_paths must map package names to folders");
       for (const auto& entry : hand["package_paths"]) {
         c.package_paths.explicit_paths[entry.first.as<std::string>()] =
             resolvePath(entry.second.as<std::string>(), base);
@@ -115,12 +117,16 @@ HandConfig loadHandConfig(const std::string& yaml_path) {
       mount.name = s["name"].as<std::string>();
       mount.link = s["link"].as<std::string>();
       // A ROS name: it becomes a topic namespace and a TF frame prefix.
-      const bool valid_name = !mount.name.empty() && std::isalpha(static_cast<unsigned char>(mount.name[0])) &&
-                              mount.name.find_first_not_of(
-                                  "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
-                                  std::string::npos;
-      if (!valid_name) throw Error(key + ".name '" + mount.name + "' is not a valid ROS name (a letter, then letters, digits, _)");
-      if (!names.insert(mount.name).second) throw Error(key + ".name '" + mount.name + "' is used twice");
+      const bool valid_name =
+          !mount.name.empty() && std::isalpha(static_cast<unsigned char>(mount.name[0])) &&
+          mount.name.find_first_not_of(
+              "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+              std::string::npos;
+      if (!valid_name)
+        throw Error(key + ".name '" + mount.name +
+                    "' is not a valid ROS name (a letter, then letters, digits, _)");
+      if (!names.insert(mount.name).second)
+        throw Error(key + ".name '" + mount.name + "' is used twice");
       if (s["gel"]) {
         mount.digit_in_link = poseFromXyzRpy(readNumbers(s["gel"], key + ".gel", 6));
         mount.gel_given = true;
@@ -131,7 +137,8 @@ HandConfig loadHandConfig(const std::string& yaml_path) {
 
     const YAML::Node joints = root["joints"];
     if (joints) {
-      if (!joints.IsMap()) throw Error("joints must map joint names (or default) to {effort, velocity, stiffness}");
+      if (!joints.IsMap())
+        throw Error("joints must map joint names (or default) to {effort, velocity, stiffness}");
       for (const auto& entry : joints) {
         const std::string name = entry.first.as<std::string>();
         const JointDriveOptions drive = readDrive(entry.second, "joints." + name);
@@ -147,7 +154,8 @@ HandConfig loadHandConfig(const std::string& yaml_path) {
       if (!initial.IsMap()) throw Error("initial_positions must map joint names to positions");
       for (const auto& entry : initial) {
         const double value = entry.second.as<double>();
-        if (!std::isfinite(value)) throw Error("initial_positions." + entry.first.as<std::string>() + " is not finite");
+        if (!std::isfinite(value))
+          throw Error("initial_positions." + entry.first.as<std::string>() + " is not finite");
         c.initial_positions[entry.first.as<std::string>()] = value;
       }
     }

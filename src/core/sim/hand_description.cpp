@@ -13,10 +13,10 @@
 #include <set>
 #include <sstream>
 
-#include <Eigen/Eigenvalues>
 #include <console_bridge/console.h>
 #include <tinyxml2.h>
 #include <urdf_parser/urdf_parser.h>
+#include <Eigen/Eigenvalues>
 
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/mesh/textured_mesh.hpp"
@@ -77,8 +77,9 @@ class CollectErrors : public console_bridge::OutputHandler {
 // Tags that urdfdom reads once per joint or link: a second one is silently ignored by it.
 void warnDuplicatedTags(const tinyxml2::XMLElement& robot, const std::string& urdf_path,
                         std::vector<std::string>& warnings) {
-  static const std::set<std::string> kOnce = {"parent", "child", "origin", "axis",    "limit",
-                                              "mimic",  "dynamics", "calibration", "safety_controller",
+  static const std::set<std::string> kOnce = {"parent",   "child",       "origin",
+                                              "axis",     "limit",       "mimic",
+                                              "dynamics", "calibration", "safety_controller",
                                               "inertial"};
   for (const tinyxml2::XMLElement* element = robot.FirstChildElement(); element;
        element = element->NextSiblingElement()) {
@@ -103,18 +104,21 @@ void warnDuplicatedTags(const tinyxml2::XMLElement& robot, const std::string& ur
 Eigen::Isometry3d toIsometry(const urdf::Pose& pose) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
-  t.linear() = Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y,
-                                  pose.rotation.z)
-                   .normalized()
-                   .toRotationMatrix();
+  t.linear() =
+      Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+          .normalized()
+          .toRotationMatrix();
   return t;
 }
 
 const char* jointTypeName(int type) {
   switch (type) {
-    case urdf::Joint::FLOATING: return "floating";
-    case urdf::Joint::PLANAR: return "planar";
-    default: return "unknown";
+    case urdf::Joint::FLOATING:
+      return "floating";
+    case urdf::Joint::PLANAR:
+      return "planar";
+    default:
+      return "unknown";
   }
 }
 
@@ -140,8 +144,8 @@ Eigen::AlignedBox3d collisionBounds(const HandLink& link) {
     if (c.kind == HandCollision::Kind::kCylinder) half = {c.size.x(), c.size.x(), c.size.y() / 2};
     if (c.kind == HandCollision::Kind::kSphere) half = Eigen::Vector3d::Constant(c.size.x());
     for (int k = 0; k < 8; ++k) {
-      add(c.origin, half.cwiseProduct(Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1,
-                                                      k & 4 ? 1 : -1)));
+      add(c.origin,
+          half.cwiseProduct(Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
     }
   }
   return bounds;
@@ -160,14 +164,14 @@ void repairInertia(HandLink& link, const std::string& urdf_path,
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(link.inertia);
   const Eigen::Vector3d moments = solver.eigenvalues();  // ascending
   const bool finite = link.inertia.allFinite();
-  const bool triangle = finite && moments(0) + moments(1) >= moments(2) * (1 - 1e-9) &&
-                        moments(0) > 0.0;
+  const bool triangle =
+      finite && moments(0) + moments(1) >= moments(2) * (1 - 1e-9) && moments(0) > 0.0;
   const bool scale = finite && moments.maxCoeff() <= 10.0 * box.maxCoeff() &&
                      moments.minCoeff() >= 0.1 * box.minCoeff();
   if (triangle && scale) return;
   std::ostringstream message;
-  message << urdf_path << ": link '" << link.name << "': inertia (principal moments "
-          << moments(0) << ", " << moments(1) << ", " << moments(2) << " kg m^2) is not a solid's of "
+  message << urdf_path << ": link '" << link.name << "': inertia (principal moments " << moments(0)
+          << ", " << moments(1) << ", " << moments(2) << " kg m^2) is not a solid's of "
           << link.mass_kg << " kg within its collision geometry's " << bounds.sizes().x() * 1e3
           << " x " << bounds.sizes().y() * 1e3 << " x " << bounds.sizes().z() * 1e3
           << " mm bounding box; replaced by that box's (" << box.x() << ", " << box.y() << ", "
@@ -262,7 +266,8 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
       if (root_path.filename() == package && found(root_path)) {
         return (root_path / inside).lexically_normal().string();
       }
-      if (found(root_path / package)) return (root_path / package / inside).lexically_normal().string();
+      if (found(root_path / package))
+        return (root_path / package / inside).lexically_normal().string();
     }
   }
   std::ostringstream message;
@@ -305,7 +310,8 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
         const char* filename = child->Attribute("filename");
         if (std::string(child->Name()) == "mesh" && filename) {
           try {
-            child->SetAttribute("filename", ("file://" + resolveUri(filename, base_dir, paths)).c_str());
+            child->SetAttribute("filename",
+                                ("file://" + resolveUri(filename, base_dir, paths)).c_str());
           } catch (const Error&) {
           }
         }
@@ -329,8 +335,9 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
   }
   console_bridge::restorePreviousOutputHandler();
   if (!model) {
-    throw Error(urdf_path + ": invalid URDF: " +
-                (errors.messages().empty() ? std::string("urdfdom refused it") : errors.messages()));
+    throw Error(
+        urdf_path + ": invalid URDF: " +
+        (errors.messages().empty() ? std::string("urdfdom refused it") : errors.messages()));
   }
   hand.name = model->getName();
 
@@ -369,17 +376,26 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
       joint.child_link = static_cast<int>(hand.links.size());
       joint.origin = toIsometry(j.parent_to_joint_origin_transform);
       switch (j.type) {
-        case urdf::Joint::REVOLUTE: joint.type = HandJoint::Type::kRevolute; break;
-        case urdf::Joint::CONTINUOUS: joint.type = HandJoint::Type::kContinuous; break;
-        case urdf::Joint::PRISMATIC: joint.type = HandJoint::Type::kPrismatic; break;
-        case urdf::Joint::FIXED: joint.type = HandJoint::Type::kFixed; break;
+        case urdf::Joint::REVOLUTE:
+          joint.type = HandJoint::Type::kRevolute;
+          break;
+        case urdf::Joint::CONTINUOUS:
+          joint.type = HandJoint::Type::kContinuous;
+          break;
+        case urdf::Joint::PRISMATIC:
+          joint.type = HandJoint::Type::kPrismatic;
+          break;
+        case urdf::Joint::FIXED:
+          joint.type = HandJoint::Type::kFixed;
+          break;
         default:
           throw Error(urdf_path + ": joint '" + j.name + "' is " + jointTypeName(j.type) +
                       ": a hand's joints are revolute, continuous, prismatic or fixed");
       }
       if (joint.movable()) {
         const Eigen::Vector3d axis(j.axis.x, j.axis.y, j.axis.z);
-        if (!(axis.norm() > 0.0)) throw Error(urdf_path + ": joint '" + j.name + "' has a zero axis");
+        if (!(axis.norm() > 0.0))
+          throw Error(urdf_path + ": joint '" + j.name + "' has a zero axis");
         joint.axis = axis.normalized();
       }
       if (joint.type == HandJoint::Type::kContinuous) {
@@ -422,7 +438,8 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
       throw Error(urdf_path + ": joint '" + joint.name + "' mimics '" + master + "', which " +
                   (model->getJoint(master) ? "is outside root_link's subtree" : "does not exist"));
     }
-    if (!hand.joints[joint.mimic_master].movable() || hand.joints[joint.mimic_master].mimic_master >= 0) {
+    if (!hand.joints[joint.mimic_master].movable() ||
+        hand.joints[joint.mimic_master].mimic_master >= 0) {
       throw Error(urdf_path + ": joint '" + joint.name + "' mimics '" + master +
                   "', which is fixed or itself a mimic joint");
     }

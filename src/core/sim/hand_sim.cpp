@@ -127,7 +127,8 @@ HandSim::HandSim(const HandSimConfig& config) : config_(config) {
   }
   for (size_t j = 0; j < joints; ++j) {
     bool clamped = false;
-    if (description_.joints[j].movable()) q_[j] = clampToLimits(static_cast<int>(j), q_[j], clamped);
+    if (description_.joints[j].movable())
+      q_[j] = clampToLimits(static_cast<int>(j), q_[j], clamped);
   }
   for (size_t j = 0; j < joints; ++j) {
     const HandJoint& joint = description_.joints[j];
@@ -246,7 +247,8 @@ void HandSim::checkMounts() {
       if (c.kind != HandCollision::Kind::kMesh) continue;
       for (const Eigen::Vector3d& v : c.mesh_vertices) {
         const Eigen::Vector3d p = link_in_gel * (c.origin * v);
-        if (std::abs(p.x()) <= config_.gel_width_m / 2 && std::abs(p.y()) <= config_.gel_height_m / 2) {
+        if (std::abs(p.x()) <= config_.gel_width_m / 2 &&
+            std::abs(p.y()) <= config_.gel_height_m / 2) {
           front = std::max(front, p.z());
         }
       }
@@ -295,12 +297,19 @@ void HandSim::buildWorld() {
     for (const HandCollision& c : link.collisions) {
       std::unique_ptr<btCollisionShape> shape;
       switch (c.kind) {
-        case HandCollision::Kind::kBox: shape = std::make_unique<btBoxShape>(toBt(c.size / 2)); break;
-        case HandCollision::Kind::kCylinder:
-          shape = std::make_unique<btCylinderShapeZ>(btVector3(c.size.x(), c.size.x(), c.size.y() / 2));
+        case HandCollision::Kind::kBox:
+          shape = std::make_unique<btBoxShape>(toBt(c.size / 2));
           break;
-        case HandCollision::Kind::kSphere: shape = std::make_unique<btSphereShape>(c.size.x()); break;
-        case HandCollision::Kind::kMesh: shape = bulletHull(c.mesh_vertices); break;
+        case HandCollision::Kind::kCylinder:
+          shape =
+              std::make_unique<btCylinderShapeZ>(btVector3(c.size.x(), c.size.x(), c.size.y() / 2));
+          break;
+        case HandCollision::Kind::kSphere:
+          shape = std::make_unique<btSphereShape>(c.size.x());
+          break;
+        case HandCollision::Kind::kMesh:
+          shape = bulletHull(c.mesh_vertices);
+          break;
       }
       if (c.kind != HandCollision::Kind::kMesh) {
         shape->setMargin(std::min<double>(kBoxMargin, 0.25 * c.size.head<2>().maxCoeff()));
@@ -347,7 +356,8 @@ void HandSim::buildWorld() {
   const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
   Eigen::Vector3d gel_axis = Eigen::Vector3d::UnitY();
   if (!sensor_links_.empty()) {
-    gel_axis = (config_.object_pose.linear().transpose() * gelInWorld(0).linear().col(2)).normalized();
+    gel_axis =
+        (config_.object_pose.linear().transpose() * gelInWorld(0).linear().col(2)).normalized();
   }
   ObjectCollisionShapes shapes = makeObjectCollision(
       object_, config_.object.collision, centre, config_.gel_law.points().back().first, gel_axis);
@@ -372,8 +382,7 @@ void HandSim::buildWorld() {
   w.manifolds.resize(sensor_links_.size());
   for (size_t s = 0; s < sensor_links_.size(); ++s) {
     for (size_t k = 0; k < parts; ++k) {
-      btPersistentManifold* manifold =
-          w.dispatcher.getNewManifold(w.gels[s].get(), w.object.get());
+      btPersistentManifold* manifold = w.dispatcher.getNewManifold(w.gels[s].get(), w.object.get());
       manifold->setContactBreakingThreshold(kContactBreakingM);
       w.manifolds[s].push_back(manifold);
     }
@@ -395,8 +404,8 @@ void HandSim::placeBodies() {
   }
   for (size_t s = 0; s < w.gels.size(); ++s) {
     // The gel box's centre sits half a thickness behind the gel surface (gel -z).
-    const Eigen::Isometry3d box = gelInWorld(static_cast<int>(s)) *
-                                  Eigen::Translation3d(0, 0, -config_.gel_thickness_m / 2);
+    const Eigen::Isometry3d box =
+        gelInWorld(static_cast<int>(s)) * Eigen::Translation3d(0, 0, -config_.gel_thickness_m / 2);
     w.gels[s]->setWorldTransform(toBt(box));
     w.gels[s]->setInterpolationWorldTransform(w.gels[s]->getWorldTransform());
   }
@@ -417,7 +426,8 @@ std::vector<int> HandSim::validateNames(const std::vector<std::string>& names) c
                   description_.joints[description_.joints[j].mimic_master].name +
                   "': command its master");
     }
-    if (std::count(joints.begin(), joints.end(), j)) throw Error("joint '" + name + "' is named twice");
+    if (std::count(joints.begin(), joints.end(), j))
+      throw Error("joint '" + name + "' is named twice");
     joints.push_back(j);
   }
   return joints;
@@ -454,9 +464,9 @@ std::vector<std::string> HandSim::setTrajectory(const JointTrajectoryCommand& t)
     const double time = t.times_s[p];
     if (!std::isfinite(time) || time < 0.0 || (p > 0 && time <= previous)) {
       std::ostringstream message;
-      message << "joint trajectory: point " << p << "'s time_from_start " << time
-              << " s is not " << (time < 0.0 || !std::isfinite(time) ? "finite and >= 0" :
-                                  "after the previous point's");
+      message << "joint trajectory: point " << p << "'s time_from_start " << time << " s is not "
+              << (time < 0.0 || !std::isfinite(time) ? "finite and >= 0"
+                                                     : "after the previous point's");
       throw Error(message.str());
     }
     previous = time;
@@ -513,7 +523,8 @@ void HandSim::setOpening(double opening) {
 
 void HandSim::setBasePose(const Eigen::Isometry3d& base_in_world, double duration_s) {
   if (!isPose(base_in_world)) throw Error("base pose is not a finite rigid pose");
-  if (!(duration_s >= 0.0 && duration_s <= 3600.0)) throw Error("base motion duration must be in [0, 3600] s");
+  if (!(duration_s >= 0.0 && duration_s <= 3600.0))
+    throw Error("base motion duration must be in [0, 3600] s");
   base_from_ = base_pose_;
   base_to_ = base_in_world;
   base_tick_ = 0;
@@ -545,7 +556,8 @@ void HandSim::resetObject(const Eigen::Isometry3d& object_in_world, bool gravity
 }
 
 void HandSim::reset(const Eigen::Isometry3d* object_in_world) {
-  if (object_in_world && !isPose(*object_in_world)) throw Error("object pose is not a finite rigid pose");
+  if (object_in_world && !isPose(*object_in_world))
+    throw Error("object pose is not a finite rigid pose");
   if (object_in_world) config_.object_pose = *object_in_world;
   q_ = initial_q_;
   drive_q_ = q_;
@@ -730,8 +742,8 @@ void HandSim::updateGelStiffness() {
                          : config_.gel_law.secantStiffness(0.0);
     world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
     const double patch_radius = points == 1 ? std::sqrt(2.0 * min_half_size * deepest) : 0.0;
-    const btScalar spinning = static_cast<btScalar>(3.0 * M_PI / 16.0 *
-                                                    config_.object.friction * patch_radius);
+    const btScalar spinning =
+        static_cast<btScalar>(3.0 * M_PI / 16.0 * config_.object.friction * patch_radius);
     for (btPersistentManifold* manifold : world_->manifolds[i]) {
       for (int c = 0; c < manifold->getNumContacts(); ++c) {
         btManifoldPoint& point = manifold->getContactPoint(c);
@@ -775,13 +787,14 @@ void HandSim::measureContacts(double dt) {
     state.object_in_gel = gel_in_world.inverse() * object_in_world;
     gel_points_[i] = gelPoints(static_cast<int>(i));
     for (const std::vector<GelContactPoint>& part : gel_points_[i]) {
-      for (const GelContactPoint& p : part) state.penetration_m = std::max(state.penetration_m, p.depth);
+      for (const GelContactPoint& p : part)
+        state.penetration_m = std::max(state.penetration_m, p.depth);
     }
     state.too_deep = state.penetration_m > deepest_law_point;
     Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
     const Eigen::Vector3d out_of_gel = gel_in_world.linear().col(2);
-    const double k_gel = config_.gel_law.tangentStiffness(
-        std::min(state.penetration_m, config_.gel_thickness_m));
+    const double k_gel =
+        config_.gel_law.tangentStiffness(std::min(state.penetration_m, config_.gel_thickness_m));
     for (btPersistentManifold* manifold : world_->manifolds[i]) {
       for (int c = 0; c < manifold->getNumContacts(); ++c) {
         const btManifoldPoint& point = manifold->getContactPoint(c);
@@ -798,8 +811,9 @@ void HandSim::measureContacts(double dt) {
       }
     }
     // The gel's stiffness as the drive sees it, at the patch's centre: the law's tangent.
-    if (state.penetration_m > 0.0) addLoad(sensor_links_[i], gel_in_world.translation(),
-                                           Eigen::Vector3d::Zero(), out_of_gel, k_gel);
+    if (state.penetration_m > 0.0)
+      addLoad(sensor_links_[i], gel_in_world.translation(), Eigen::Vector3d::Zero(), out_of_gel,
+              k_gel);
     state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
     state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
     state.shear_force_n.z() = 0.0;
@@ -820,10 +834,11 @@ void HandSim::measureContacts(double dt) {
     for (int c = 0; c < manifold->getNumContacts(); ++c) {
       const btManifoldPoint& point = manifold->getContactPoint(c);
       // The normal points from B to A; a positive impulse pushes A along it.
-      Eigen::Vector3d on_a = toEigen(point.m_normalWorldOnB) * point.getAppliedImpulse() / dt +
-                             (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
-                              toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
-                                 dt;
+      Eigen::Vector3d on_a =
+          toEigen(point.m_normalWorldOnB) * point.getAppliedImpulse() / dt +
+          (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
+           toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
+              dt;
       const Eigen::Vector3d on_link = object_is_b ? on_a : Eigen::Vector3d(-on_a);
       addLoad(link, toEigen(object_is_b ? point.m_positionWorldOnA : point.m_positionWorldOnB),
               on_link, Eigen::Vector3d::Zero(), 0.0);

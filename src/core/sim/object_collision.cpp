@@ -15,7 +15,8 @@ constexpr double kMaxHullDeviationM = 0.15e-3;
 btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
 Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
-std::vector<Eigen::Vector3d> verticesAbout(const TexturedMesh& mesh, const Eigen::Vector3d& centre) {
+std::vector<Eigen::Vector3d> verticesAbout(const TexturedMesh& mesh,
+                                           const Eigen::Vector3d& centre) {
   std::vector<Eigen::Vector3d> points;
   points.reserve(mesh.vertices().size());
   for (const Eigen::Vector3f& v : mesh.vertices()) points.push_back(v.cast<double>() - centre);
@@ -64,8 +65,8 @@ ObjectCollisionShapes makeObjectCollision(const ObjectMesh& o, const std::string
     out.shapes.push_back(std::move(box));
     std::vector<Eigen::Vector3d> corners;
     for (int k = 0; k < 8; ++k) {
-      corners.push_back(half.cwiseProduct(
-          Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
+      corners.push_back(
+          half.cwiseProduct(Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1)));
     }
     out.contact_parts.push_back(ConvexPolytope::hullOf(corners));
     out.collision.kind = "box";
@@ -106,7 +107,8 @@ ObjectCollisionShapes makeObjectCollision(const ObjectMesh& o, const std::string
         // A flat sliver (HACD can return one): nothing a gel could press into.
       }
     }
-    if (out.contact_parts.empty()) throw Error("convex decomposition of the object mesh produced no solid part");
+    if (out.contact_parts.empty())
+      throw Error("convex decomposition of the object mesh produced no solid part");
     out.collision.kind = "decomposition";
     out.collision.parts = static_cast<int>(out.contact_parts.size());
     return out;

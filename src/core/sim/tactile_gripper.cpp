@@ -5,9 +5,9 @@
 #include <sstream>
 
 #include "norm2tex/common/error.hpp"
-#include "sim/tactile_options.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
+#include "sim/tactile_options.hpp"
 
 namespace norm2tex {
 namespace {
@@ -17,7 +17,9 @@ constexpr std::size_t kKeptVariants = 32;
 
 }  // namespace
 
-void validate(const TactileGripperOptions& o) { detail::validateTactileOptions(o, "tactile gripper option"); }
+void validate(const TactileGripperOptions& o) {
+  detail::validateTactileOptions(o, "tactile gripper option");
+}
 
 TactileGripper::TactileGripper(GripperSimConfig scene, const SensorModel& sensor,
                                const TactileGripperOptions& options,
@@ -34,8 +36,8 @@ TactileGripper::TactileGripper(GripperSimConfig scene, const SensorModel& sensor
   if (material) scene.object.material = material->name;
   setGelFromSensor(sensor, scene);
   // Whole physics ticks per sensor frame, so every frame is a physics state (as contact_sim).
-  ticks_per_frame_ = std::max(
-      1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
+  ticks_per_frame_ =
+      std::max(1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
   scene.physics.rate_hz = ticks_per_frame_ * options_.frame_rate_hz;
   sim_ = std::make_unique<GripperSim>(scene);
   mesh_ = std::make_shared<TexturedMesh>(sim_->object().mesh);
@@ -86,7 +88,8 @@ void TactileGripper::useVariant(int variant) {
 }
 
 void TactileGripper::setVariant(int variant) {
-  if (variant < 0) throw Error("texture variant " + std::to_string(variant) + " refused; valid: >= 0");
+  if (variant < 0)
+    throw Error("texture variant " + std::to_string(variant) + " refused; valid: >= 0");
   if (beta_mm_ <= 0.0) {
     if (options_.material_config.empty()) {
       throw Error("texture variant " + std::to_string(variant) +
@@ -132,11 +135,12 @@ void TactileGripper::stepPhysics(int frames) {
 void TactileGripper::render(Finger finger) {
   const std::int64_t frame =
       options_.noise_per_episode ? frameIndex() - episode_first_frame_ : frameIndex();
-  const std::int64_t noise_seed = options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
+  const std::int64_t noise_seed =
+      options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
   // The gel's normal force from the physics: it sets how much of the texture the gel follows
   // (GelConformity) when the sensor's conformity is on.
-  frames_[index(finger)] = &renderers_[index(finger)]->render(
-      objectInGel(finger), noise_seed, sim_->contact(finger).normal_force_n);
+  frames_[index(finger)] = &renderers_[index(finger)]->render(objectInGel(finger), noise_seed,
+                                                              sim_->contact(finger).normal_force_n);
 }
 
 Eigen::Isometry3d TactileGripper::objectInGel(Finger finger) const {

@@ -5,10 +5,10 @@
 #include <sstream>
 
 #include "norm2tex/common/error.hpp"
-#include "sim/tactile_options.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/sim/tactile_gripper.hpp"
+#include "sim/tactile_options.hpp"
 
 namespace norm2tex {
 namespace {
@@ -18,7 +18,9 @@ constexpr std::size_t kKeptVariants = 32;
 
 }  // namespace
 
-void validate(const TactileHandOptions& o) { detail::validateTactileOptions(o, "tactile hand option"); }
+void validate(const TactileHandOptions& o) {
+  detail::validateTactileOptions(o, "tactile hand option");
+}
 
 TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
                          const TactileHandOptions& options,
@@ -37,8 +39,8 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
   config.gel_height_m = sensor.gel_pad_height_mm * 1e-3;
   config.gel_thickness_m = sensor.gel_thickness_mm * 1e-3;
   // Whole physics ticks per sensor frame, so every frame is a physics state.
-  ticks_per_frame_ = std::max(
-      1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
+  ticks_per_frame_ =
+      std::max(1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
   config.physics.rate_hz = ticks_per_frame_ * options_.frame_rate_hz;
   sim_ = std::make_unique<HandSim>(config);
   mesh_ = std::make_shared<TexturedMesh>(sim_->object().mesh);
@@ -67,10 +69,13 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
       texture = textures_->get(key, [&] { return *unwrapped; }).texture;
     } else {
       std::shared_ptr<const TexturedMesh> mesh = mesh_;
-      texture = textures_->get(key, [source, mesh] {
-        TexturedMesh copy = *mesh;
-        return loadObjectTexture(source, copy);
-      }).texture;
+      texture = textures_
+                    ->get(key,
+                          [source, mesh] {
+                            TexturedMesh copy = *mesh;
+                            return loadObjectTexture(source, copy);
+                          })
+                    .texture;
     }
     for (auto& renderer : renderers_) renderer->setObject(mesh_, texture->atlas, beta_mm_);
   } else {
@@ -115,7 +120,8 @@ void TactileHand::render(int sensor) {
   checkSensor(sensor);
   const std::int64_t frame =
       options_.noise_per_episode ? frameIndex() - episode_first_frame_ : frameIndex();
-  const std::int64_t noise_seed = options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
+  const std::int64_t noise_seed =
+      options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
   frames_[sensor] = &renderers_[sensor]->render(objectInGel(sensor), noise_seed,
                                                 sim_->contact(sensor).normal_force_n);
 }

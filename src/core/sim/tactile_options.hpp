@@ -20,7 +20,8 @@ void validateTactileOptions(const Options& o, const std::string& what) {
     out << value;
     return out.str();
   };
-  const auto bad = [&](const std::string& name, const std::string& value, const std::string& valid) {
+  const auto bad = [&](const std::string& name, const std::string& value,
+                       const std::string& valid) {
     throw Error(what + " " + name + " = " + value + " is out of range; valid: " + valid);
   };
   if (!(o.physics_rate_hz >= 100.0 && o.physics_rate_hz <= 100000.0)) {

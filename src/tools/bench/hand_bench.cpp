@@ -49,7 +49,8 @@ void BM_HandSim_Tick_AllegroMovingFree(benchmark::State& state) {
   int ticks = 0;
   for (auto _ : state) {
     // Every joint moves: a new target every 0.2 s.
-    if (ticks++ % 200 == 0) sim.setJointTargets(sim.actuatedJoints(), (ticks / 200) % 2 ? up : down);
+    if (ticks++ % 200 == 0)
+      sim.setJointTargets(sim.actuatedJoints(), (ticks / 200) % 2 ? up : down);
     sim.step(1);
   }
   state.counters["ticks/s"] =
@@ -68,8 +69,8 @@ void BM_HandSim_Tick_AllegroHoldingSphere(benchmark::State& state) {
   norm2tex::HandSim sim(config);
   sim.step(500);
   norm2tex::JointTrajectoryCommand close;
-  close.joint_names = {"joint_1.0", "joint_2.0", "joint_3.0", "joint_5.0", "joint_6.0",
-                       "joint_7.0", "joint_9.0", "joint_10.0", "joint_11.0", "joint_12.0",
+  close.joint_names = {"joint_1.0",  "joint_2.0",  "joint_3.0",  "joint_5.0",  "joint_6.0",
+                       "joint_7.0",  "joint_9.0",  "joint_10.0", "joint_11.0", "joint_12.0",
                        "joint_13.0", "joint_14.0", "joint_15.0"};
   close.times_s = {2.0};
   close.positions = {{1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.3, 1.39, 1.15, 1.15, 1.15}};
