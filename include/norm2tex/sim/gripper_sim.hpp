@@ -169,14 +169,6 @@ class GripperSim {
   double compliantFingerPosition(double max_move) const;
   /// How far a finger sits back from its drive when its gel is indented `depth`, m (0: rigid).
   double drivePreload(double depth) const;
-  /// Calls visit(btManifoldPoint&) for every contact point between gel `gel_index` and the
-  /// object (the gel is the manifold's body 0).
-  template <typename Visit>
-  void forEachGelPoint(int gel_index, Visit visit) const;
-  /// Where the object reaches into gel `gel_index` now, per contact part.
-  std::vector<std::vector<GelContactPoint>> gelPoints(int gel_index) const;
-  void updateGelContacts();
-  void updateGelStiffness();
   void measureContacts(double dt);
   /// Closes from the open seat until both gels touch, then to the configured grip.
   double closeOnTheObject(double offset_m);
@@ -195,13 +187,8 @@ class GripperSim {
   std::optional<Capsule> contact_capsule_;
   ObjectCollision collision_;
   std::pair<double, double> height_offset_range_;
-  /// Where the object reaches into each gel (per part) after the last step, and the finger
-  /// position it was measured at.
-  std::array<std::vector<std::vector<GelContactPoint>>, 2> gel_points_;
-  bool points_valid_ = false;
-  double points_finger_position_m_ = 0.0;
   std::unique_ptr<World> world_;
-  std::array<GelContactState, 2> contacts_;
+  std::vector<GelContactState> contacts_ = std::vector<GelContactState>(2);  ///< left, right
   double command_ = 1.0;
   double finger_position_m_ = 0.0;
   /// Where the drive has brought the fingers (the command, speed- and force-limited); the

@@ -167,9 +167,6 @@ class HandSim {
   void moveJoints(double dt);
   void forwardKinematics();
   void placeBodies();
-  std::vector<std::vector<GelContactPoint>> gelPoints(int sensor) const;
-  void updateGelContacts();
-  void updateGelStiffness();
   void measureContacts(double dt);
   /// Adds the generalised force of `force` (world, on link `link`) at `point` to every joint
   /// that carries the link; and, when `normal_stiffness` > 0, that contact's stiffness along
@@ -205,7 +202,6 @@ class HandSim {
   ObjectCollision collision_;
   std::unique_ptr<World> world_;
   std::vector<GelContactState> contacts_;
-  std::vector<std::vector<std::vector<GelContactPoint>>> gel_points_;
   std::int64_t ticks_ = 0;
 };
 

@@ -9,6 +9,8 @@
 #include <btBulletDynamicsCommon.h>
 
 #include "norm2tex/common/error.hpp"
+#include "sim/bullet_eigen.hpp"
+#include "sim/gel_pad_contacts.hpp"
 #include "sim/object_collision.hpp"
 
 namespace norm2tex {
@@ -18,9 +20,6 @@ namespace {
 constexpr double kSeatClearance = 1e-3;
 // After the fingers reach the grasp command, the contact settles this long before gravity.
 constexpr double kGraspHoldS = 0.1;
-// A gel contact point that slides this far along the gel, or separates this far, is dropped
-// (Bullet's contact breaking threshold for the package's own manifolds).
-constexpr double kContactBreakingM = 3e-4;
 // An object's side must overlap the gel pads by this much (height) at a height offset reset()
 // accepts.
 constexpr double kMinPadOverlap = 1e-3;
@@ -28,22 +27,6 @@ constexpr double kMinPadOverlap = 1e-3;
 // contacts), the object still meets the floor.
 constexpr int kGelGroup = 1 << 6;
 constexpr int kObjectGroup = 1 << 7;
-
-btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
-Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
-
-btTransform toBt(const Eigen::Isometry3d& pose) {
-  const Eigen::Quaterniond q(pose.rotation());
-  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), toBt(pose.translation()));
-}
-
-Eigen::Isometry3d toEigen(const btTransform& t) {
-  const btQuaternion q = t.getRotation();
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-  pose.translation() = toEigen(t.getOrigin());
-  return pose;
-}
 
 // Uniform in [0, 1) from a 64-bit engine, the same on every platform
 // (std::uniform_real_distribution is not specified bit for bit).
@@ -59,21 +42,13 @@ struct GripperSim::World {
   btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &collision_config};
 
   std::unique_ptr<btCollisionShape> floor_shape;
-  std::unique_ptr<btCollisionShape> gel_shape;
   std::unique_ptr<btRigidBody> floor;
-  std::array<std::unique_ptr<btRigidBody>, 2> gels;
+  std::unique_ptr<GelPadContacts> gels;  ///< the left gel's is pad 0, the right's pad 1
   std::unique_ptr<btRigidBody> object;
-  /// Per gel, one manifold per convex part of the object (body 0 the gel, body 1 the object).
-  std::array<std::vector<btPersistentManifold*>, 2> manifolds;
 
   ~World() {
-    for (auto& gel_manifolds : manifolds) {
-      for (btPersistentManifold* manifold : gel_manifolds) dispatcher.releaseManifold(manifold);
-    }
+    gels.reset();  // its manifolds name the object
     if (object) world.removeRigidBody(object.get());
-    for (auto& gel : gels) {
-      if (gel) world.removeRigidBody(gel.get());
-    }
     if (floor) world.removeRigidBody(floor.get());
   }
 };
@@ -242,7 +217,6 @@ Eigen::Isometry3d GripperSim::objectInWorld() const {
 }
 
 void GripperSim::buildWorld(double object_height_m) {
-  points_valid_ = false;
   world_ = std::make_unique<World>();
   btDiscreteDynamicsWorld& w = world_->world;
   const PhysicsOptions& p = config_.physics;
@@ -266,25 +240,17 @@ void GripperSim::buildWorld(double object_height_m) {
   w.addRigidBody(world_->floor.get(), btBroadphaseProxy::StaticFilter,
                  btBroadphaseProxy::AllFilter & ~kGelGroup);
 
-  // Gels: kinematic boxes behind the gel surface, soft-contact, with the material's friction
-  // (Bullet multiplies the two bodies' coefficients; the object's is 1).
-  const btVector3 gel_half(config_.gel_width_m / 2, config_.gel_height_m / 2,
-                           config_.gel_thickness_m / 2);
-  auto gel_box = std::make_unique<btBoxShape>(gel_half);
-  gel_box->setMargin(kBoxMargin);
-  world_->gel_shape = std::move(gel_box);
-  for (int i = 0; i < 2; ++i) {
-    btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, world_->gel_shape.get());
-    info.m_friction = config_.object.friction;
-    info.m_restitution = 0;
-    auto gel = std::make_unique<btRigidBody>(info);
-    gel->setCollisionFlags(gel->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT |
-                           btCollisionObject::CF_HAS_FRICTION_ANCHOR);
-    gel->setActivationState(DISABLE_DEACTIVATION);
-    gel->setContactStiffnessAndDamping(config_.gel_law.secantStiffness(0.0), p.gel_damping);
-    w.addRigidBody(gel.get(), kGelGroup, 0);
-    world_->gels[i] = std::move(gel);
-  }
+  // Gels: the package's compliant contact with the material's friction (Bullet multiplies the
+  // two bodies' coefficients; the object's is 1).
+  GelPadOptions pads;
+  pads.width_m = config_.gel_width_m;
+  pads.height_m = config_.gel_height_m;
+  pads.thickness_m = config_.gel_thickness_m;
+  pads.friction = config_.object.friction;
+  pads.damping = p.gel_damping;
+  pads.law = config_.gel_law;
+  pads.object_min_half_size_m = objectMinHalfSizeM();
+  world_->gels = std::make_unique<GelPadContacts>(w, world_->dispatcher, 2, pads, kGelGroup);
 
   // Object: dynamic, its body at its bounds' centre.
   btCollisionShape* shape = object_shapes_.back().get();
@@ -302,18 +268,10 @@ void GripperSim::buildWorld(double object_height_m) {
   world_->object->setWorldTransform(toBt(body));
   w.addRigidBody(world_->object.get(), kObjectGroup, btBroadphaseProxy::StaticFilter);
   // The gel contacts live in the package's own manifolds, which the solver takes like any other.
-  const size_t parts = contact_capsule_ ? 1 : contact_parts_.size();
-  for (int i = 0; i < 2; ++i) {
-    for (size_t k = 0; k < parts; ++k) {
-      btPersistentManifold* manifold =
-          world_->dispatcher.getNewManifold(world_->gels[i].get(), world_->object.get());
-      manifold->setContactBreakingThreshold(kContactBreakingM);
-      world_->manifolds[i].push_back(manifold);
-    }
-  }
+  world_->gels->attach(*world_->object, GelContactGeometry{&contact_parts_, &contact_capsule_});
 
   moveFingers(0.0);
-  contacts_ = {};
+  contacts_.assign(2, GelContactState{});
   for (int i = 0; i < 2; ++i) {
     contacts_[i].object_in_gel = gelInWorld(static_cast<Finger>(i)).inverse() * objectInWorld();
   }
@@ -331,15 +289,7 @@ void GripperSim::moveFingers(double dt) {
   finger_position_m_ = config_.gripper.stiffness_n_per_m > 0.0
                            ? compliantFingerPosition(max_move)
                            : drive_position_m_;
-  for (int i = 0; i < 2; ++i) {
-    // The gel box's centre sits half a thickness behind the gel surface (gel -z).
-    const Eigen::Isometry3d box = gelInWorld(static_cast<Finger>(i)) *
-                                  Eigen::Translation3d(0, 0, -config_.gel_thickness_m / 2);
-    btRigidBody& gel = *world_->gels[i];
-    // Kinematic bodies: Bullet derives their velocity from the change of this transform.
-    gel.setWorldTransform(toBt(box));
-    gel.setInterpolationWorldTransform(gel.getWorldTransform());
-  }
+  for (int i = 0; i < 2; ++i) world_->gels->place(i, gelInWorld(static_cast<Finger>(i)));
 }
 
 double GripperSim::compliantFingerPosition(double max_move) const {
@@ -363,154 +313,9 @@ double GripperSim::compliantFingerPosition(double max_move) const {
   return finger_position_m_ + std::clamp(residual * k / (k + k_gel), -max_move, max_move);
 }
 
-template <typename Visit>
-void GripperSim::forEachGelPoint(int gel_index, Visit visit) const {
-  for (btPersistentManifold* manifold : world_->manifolds[gel_index]) {
-    for (int c = 0; c < manifold->getNumContacts(); ++c) visit(manifold->getContactPoint(c));
-  }
-}
-
-std::vector<std::vector<GelContactPoint>> GripperSim::gelPoints(int gel_index) const {
-  const GelPad pad{config_.gel_width_m / 2, config_.gel_height_m / 2};
-  const Eigen::Isometry3d body_in_gel =
-      gelInWorld(static_cast<Finger>(gel_index)).inverse() *
-      toEigen(world_->object->getWorldTransform());
-  std::vector<std::vector<GelContactPoint>> points;
-  if (contact_capsule_) {
-    points.push_back(gelContactPoints(*contact_capsule_, body_in_gel, pad));
-  } else {
-    for (const ConvexPolytope& part : contact_parts_) {
-      points.push_back(gelContactPoints(part, body_in_gel, pad));
-    }
-  }
-  return points;
-}
-
-void GripperSim::updateGelContacts() {
-  // The object's points inside each gel pad, at most four per part, join the manifold as Bullet
-  // adds its own: a new point near a kept one replaces it, unless the kept one is an anchor
-  // inside its friction cone (btPersistentManifold::replaceContactPoint); kept points are
-  // first moved with their bodies and dropped once they separate, slide or leave the pad.
-  const btRigidBody& object = *world_->object;
-  const double half_w = config_.gel_width_m / 2, half_h = config_.gel_height_m / 2;
-  for (int i = 0; i < 2; ++i) {
-    const btRigidBody& gel = *world_->gels[i];
-    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
-    const Eigen::Isometry3d world_in_gel = gel_in_world.inverse();
-    const Eigen::Vector3d normal_on_object = -gel_in_world.linear().col(2);  // into the gel
-    // The last step's measurement still holds unless the finger has moved since (the object
-    // has not: nothing moves it between a step and the next tick's contacts).
-    if (!points_valid_ || finger_position_m_ != points_finger_position_m_) {
-      gel_points_[i] = gelPoints(i);
-    }
-    const std::vector<std::vector<GelContactPoint>>& parts = gel_points_[i];
-    for (size_t k = 0; k < parts.size(); ++k) {
-      btPersistentManifold& manifold = *world_->manifolds[i][k];
-      manifold.refreshContactPoints(gel.getWorldTransform(), object.getWorldTransform());
-      for (int c = manifold.getNumContacts() - 1; c >= 0; --c) {
-        const Eigen::Vector3d on_object =
-            world_in_gel * toEigen(manifold.getContactPoint(c).m_positionWorldOnB);
-        // (Points the pad's edge clipped lie on it: a kept anchor there may move past it by
-        // as much as it may slide, or every held object would lose its anchors there.)
-        if (std::abs(on_object.x()) > half_w + kContactBreakingM ||
-            std::abs(on_object.y()) > half_h + kContactBreakingM) {
-          manifold.removeContactPoint(c);
-        }
-      }
-      for (const GelContactPoint& p : spanningContactPoints(parts[k])) {
-        const Eigen::Vector3d on_object = gel_in_world * p.position;
-        const Eigen::Vector3d on_gel =
-            gel_in_world * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
-        btManifoldPoint point(gel.getWorldTransform().invXform(toBt(on_gel)),
-                              object.getWorldTransform().invXform(toBt(on_object)),
-                              toBt(normal_on_object), static_cast<btScalar>(-p.depth));
-        point.m_positionWorldOnA = toBt(on_gel);
-        point.m_positionWorldOnB = toBt(on_object);
-        point.m_combinedFriction = static_cast<btScalar>(config_.object.friction);
-        point.m_combinedRestitution = 0;
-        point.m_contactPointFlags |= BT_CONTACT_FLAG_FRICTION_ANCHOR;
-        const int index = manifold.getCacheEntry(point);
-        if (index >= 0) {
-          manifold.replaceContactPoint(point, index);
-        } else {
-          manifold.addManifoldPoint(point);
-        }
-      }
-    }
-  }
-}
-
-void GripperSim::updateGelStiffness() {
-  // Secant stiffness of the law at the current penetration, shared among the contact points
-  // in proportion to their depth: sum_i k d_i = F(d_max).
-  const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
-  for (int i = 0; i < 2; ++i) {
-    double deepest = 0.0, sum = 0.0;
-    int points = 0;
-    forEachGelPoint(i, [&](const btManifoldPoint& point) {
-      ++points;
-      const double d = -point.getDistance();
-      if (d > 0.0) {
-        deepest = std::max(deepest, d);
-        sum += d;
-      }
-    });
-    // Deeper than the gel is thick the object would press on the sensor's body: the force
-    // stops growing there, so no mistake can expel the object at absurd speed.
-    const double k = sum > 0.0
-                         ? config_.gel_law.force(std::min(deepest, config_.gel_thickness_m)) / sum
-                         : config_.gel_law.secantStiffness(0.0);
-    world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
-    // The gel touches over a patch, not a point: Coulomb friction over a disc of radius a
-    // under Hertzian pressure resists twisting up to (3 pi / 16) mu F a. Several contact points
-    // resist it through their lateral friction, but a single one has no such torque, so a ball
-    // touching each gel at one hull vertex would spin freely about the grip axis. A lone point
-    // gets the patch's torsional friction, a = sqrt(2 R d) the footprint of a ball of the
-    // object's smallest half-size R at its depth d. (Bullet applies torsional friction only
-    // with rolling friction on: a negligible one, 1 nm.)
-    const double patch_radius =
-        points == 1 ? std::sqrt(2.0 * objectMinHalfSizeM() * deepest) : 0.0;
-    const btScalar spinning = static_cast<btScalar>(3.0 * M_PI / 16.0 *
-                                                    config_.object.friction * patch_radius);
-    // Points kept by a friction anchor are not re-created by collision detection: set them too.
-    forEachGelPoint(i, [&](btManifoldPoint& point) {
-      point.m_combinedContactStiffness1 = k;
-      point.m_combinedContactDamping1 = damping;
-      point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
-      point.m_combinedSpinningFriction = spinning;
-      point.m_combinedRollingFriction = spinning > 0 ? btScalar(1e-9) : btScalar(0);
-    });
-  }
-}
-
 void GripperSim::measureContacts(double dt) {
   const Eigen::Isometry3d object_in_world = objectInWorld();
-  const double deepest_law_point = config_.gel_law.points().back().first;
-  for (int i = 0; i < 2; ++i) {
-    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<Finger>(i));
-    GelContactState& state = contacts_[i];
-    state = GelContactState{};
-    state.object_in_gel = gel_in_world.inverse() * object_in_world;
-    // The indentation at the pose the step ended in: what the renderer draws.
-    gel_points_[i] = gelPoints(i);
-    for (const std::vector<GelContactPoint>& part : gel_points_[i]) {
-      for (const GelContactPoint& p : part) state.penetration_m = std::max(state.penetration_m, p.depth);
-    }
-    state.too_deep = state.penetration_m > deepest_law_point;
-    Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
-    forEachGelPoint(i, [&](const btManifoldPoint& point) {
-      state.normal_force_n += point.getAppliedImpulse() / dt;
-      // Friction impulses act on body A (the gel) along the lateral directions.
-      shear_world += (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
-                      toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
-                     dt;
-    });
-    state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
-    state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
-    state.shear_force_n.z() = 0.0;
-  }
-  points_valid_ = true;
-  points_finger_position_m_ = finger_position_m_;
+  world_->gels->measure(dt, object_in_world, contacts_);
   // Dropped: free of both gels and below their lower edge.
   const double lower_edge = config_.gripper.base_height_m - config_.gel_height_m / 2.0;
   if (!contacts_[0].in_contact && !contacts_[1].in_contact &&
@@ -525,8 +330,8 @@ void GripperSim::step(int ticks) {
   for (int t = 0; t < ticks; ++t) {
     for (int s = 0; s < substeps; ++s) {
       moveFingers(dt);
-      updateGelContacts();
-      updateGelStiffness();
+      world_->gels->updateContacts();
+      world_->gels->updateStiffness();
       world_->world.stepSimulation(dt, 0, dt);
       measureContacts(dt);
     }
@@ -617,7 +422,7 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
   };
   seat();
   for (int i = 0; i < 2; ++i) {
-    for (const auto& part : gelPoints(i)) {
+    for (const auto& part : world_->gels->objectPointsIn(i)) {
       if (!part.empty()) throw Error("the seated object overlaps a gel (a bug: please report it)");
     }
   }

@@ -10,35 +10,18 @@
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "sim/bullet_eigen.hpp"
+#include "sim/gel_pad_contacts.hpp"
 #include "sim/object_collision.hpp"
 
 namespace norm2tex {
 namespace {
 
-// A gel contact point that slides this far along the gel, or separates this far, is dropped
-// (as GripperSim's).
-constexpr double kContactBreakingM = 3e-4;
 // Collision groups: links meet the object (not each other, not the floor: they are placed by
 // the drives); gels never collide through Bullet (the package makes their contacts).
 constexpr int kLinkGroup = 1 << 5;
 constexpr int kGelGroup = 1 << 6;
 constexpr int kObjectGroup = 1 << 7;
-
-btVector3 toBt(const Eigen::Vector3d& v) { return btVector3(v.x(), v.y(), v.z()); }
-Eigen::Vector3d toEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
-
-btTransform toBt(const Eigen::Isometry3d& pose) {
-  const Eigen::Quaterniond q(pose.rotation());
-  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), toBt(pose.translation()));
-}
-
-Eigen::Isometry3d toEigen(const btTransform& t) {
-  const btQuaternion q = t.getRotation();
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized().toRotationMatrix();
-  pose.translation() = toEigen(t.getOrigin());
-  return pose;
-}
 
 bool isPose(const Eigen::Isometry3d& pose) {
   return pose.matrix().allFinite() &&
@@ -59,20 +42,15 @@ struct HandSim::World {
   std::unique_ptr<btRigidBody> floor;
   /// Per link: its kinematic body, or null when it has no collision geometry.
   std::vector<std::unique_ptr<btRigidBody>> links;
-  std::vector<std::unique_ptr<btRigidBody>> gels;
+  std::unique_ptr<GelPadContacts> gels;
   std::unique_ptr<btRigidBody> object;
   std::vector<std::unique_ptr<btCollisionShape>> object_shapes;
   std::vector<ConvexPolytope> contact_parts;
   std::optional<Capsule> contact_capsule;
-  /// Per gel, one manifold per convex part of the object (body 0 the gel, body 1 the object).
-  std::vector<std::vector<btPersistentManifold*>> manifolds;
 
   ~World() {
-    for (auto& gel_manifolds : manifolds) {
-      for (btPersistentManifold* manifold : gel_manifolds) dispatcher.releaseManifold(manifold);
-    }
+    gels.reset();  // its manifolds name the object
     if (object) world.removeRigidBody(object.get());
-    for (auto& gel : gels) world.removeRigidBody(gel.get());
     for (auto& link : links) {
       if (link) world.removeRigidBody(link.get());
     }
@@ -331,25 +309,21 @@ void HandSim::buildWorld() {
     w.links[l] = std::move(body);
   }
 
-  // Gels: kinematic boxes behind each gel surface, soft-contact, with the material's friction.
-  const btVector3 gel_half(config_.gel_width_m / 2, config_.gel_height_m / 2,
-                           config_.gel_thickness_m / 2);
-  auto gel_box = std::make_unique<btBoxShape>(gel_half);
-  gel_box->setMargin(kBoxMargin);
-  btCollisionShape* gel_shape = gel_box.get();
-  w.shapes.push_back(std::move(gel_box));
-  for (size_t s = 0; s < sensor_links_.size(); ++s) {
-    btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, gel_shape);
-    info.m_friction = config_.object.friction;
-    info.m_restitution = 0;
-    auto gel = std::make_unique<btRigidBody>(info);
-    gel->setCollisionFlags(gel->getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT |
-                           btCollisionObject::CF_HAS_FRICTION_ANCHOR);
-    gel->setActivationState(DISABLE_DEACTIVATION);
-    gel->setContactStiffnessAndDamping(config_.gel_law.secantStiffness(0.0), p.gel_damping);
-    w.world.addRigidBody(gel.get(), kGelGroup, 0);
-    w.gels.push_back(std::move(gel));
-  }
+  // Gels: the package's compliant contact, added before the object as GripperSim's.
+  GelPadOptions pads;
+  pads.width_m = config_.gel_width_m;
+  pads.height_m = config_.gel_height_m;
+  pads.thickness_m = config_.gel_thickness_m;
+  pads.friction = config_.object.friction;
+  pads.damping = p.gel_damping;
+  pads.law = config_.gel_law;
+  pads.object_min_half_size_m = static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0;
+  // A hand's gel can have the object behind it (behind its finger, across the palm), where
+  // GripperSim's two facing gels never do: a part reaching further behind the gel's surface
+  // than twice its thickness is on the sensor's other side, not pressed into its gel.
+  pads.behind_gel_m = 2.0 * config_.gel_thickness_m;
+  w.gels = std::make_unique<GelPadContacts>(w.world, w.dispatcher,
+                                            static_cast<int>(sensor_links_.size()), pads, kGelGroup);
 
   // Object: dynamic, its body at its bounds' centre. The hull's hollows are measured against
   // the first gel's normal at the start.
@@ -378,17 +352,8 @@ void HandSim::buildWorld() {
   w.object->setWorldTransform(toBt(config_.object_pose * object_in_body_.inverse()));
   w.world.addRigidBody(w.object.get(), kObjectGroup, btBroadphaseProxy::StaticFilter | kLinkGroup);
 
-  const size_t parts = w.contact_capsule ? 1 : w.contact_parts.size();
-  w.manifolds.resize(sensor_links_.size());
-  for (size_t s = 0; s < sensor_links_.size(); ++s) {
-    for (size_t k = 0; k < parts; ++k) {
-      btPersistentManifold* manifold = w.dispatcher.getNewManifold(w.gels[s].get(), w.object.get());
-      manifold->setContactBreakingThreshold(kContactBreakingM);
-      w.manifolds[s].push_back(manifold);
-    }
-  }
+  w.gels->attach(*w.object, GelContactGeometry{&w.contact_parts, &w.contact_capsule});
   contacts_.assign(sensor_links_.size(), GelContactState{});
-  gel_points_.assign(sensor_links_.size(), {});
   placeBodies();
   for (size_t s = 0; s < sensor_links_.size(); ++s) {
     contacts_[s].object_in_gel = gelInWorld(static_cast<int>(s)).inverse() * objectInWorld();
@@ -402,13 +367,7 @@ void HandSim::placeBodies() {
     w.links[l]->setWorldTransform(toBt(link_poses_[l]));
     w.links[l]->setInterpolationWorldTransform(w.links[l]->getWorldTransform());
   }
-  for (size_t s = 0; s < w.gels.size(); ++s) {
-    // The gel box's centre sits half a thickness behind the gel surface (gel -z).
-    const Eigen::Isometry3d box =
-        gelInWorld(static_cast<int>(s)) * Eigen::Translation3d(0, 0, -config_.gel_thickness_m / 2);
-    w.gels[s]->setWorldTransform(toBt(box));
-    w.gels[s]->setInterpolationWorldTransform(w.gels[s]->getWorldTransform());
-  }
+  for (int s = 0; s < w.gels->count(); ++s) w.gels->place(s, gelInWorld(s));
 }
 
 std::vector<int> HandSim::validateNames(const std::vector<std::string>& names) const {
@@ -549,9 +508,7 @@ void HandSim::resetObject(const Eigen::Isometry3d& object_in_world, bool gravity
   object.setLinearVelocity(btVector3(0, 0, 0));
   object.setAngularVelocity(btVector3(0, 0, 0));
   object.clearForces();
-  for (auto& gel_manifolds : world_->manifolds) {
-    for (btPersistentManifold* manifold : gel_manifolds) manifold->clearManifold();
-  }
+  world_->gels->clearContacts();
   setObjectGravity(gravity);
 }
 
@@ -647,116 +604,6 @@ void HandSim::moveJoints(double dt) {
   placeBodies();
 }
 
-std::vector<std::vector<GelContactPoint>> HandSim::gelPoints(int sensor) const {
-  const GelPad pad{config_.gel_width_m / 2, config_.gel_height_m / 2};
-  const Eigen::Isometry3d body_in_gel =
-      gelInWorld(sensor).inverse() * toEigen(world_->object->getWorldTransform());
-  std::vector<std::vector<GelContactPoint>> points;
-  if (world_->contact_capsule) {
-    points.push_back(gelContactPoints(*world_->contact_capsule, body_in_gel, pad));
-  } else {
-    for (const ConvexPolytope& part : world_->contact_parts) {
-      points.push_back(gelContactPoints(part, body_in_gel, pad));
-    }
-  }
-  // A hand's gel can have the object behind it (behind its finger, across the palm), where
-  // GripperSim's two facing gels never do: a part reaching further behind the gel's surface
-  // than twice its thickness is on the sensor's other side, not pressed into its gel (a real
-  // press stops at the gel's thickness: too_deep).
-  const double behind = 2.0 * config_.gel_thickness_m;
-  for (std::vector<GelContactPoint>& part : points) {
-    for (const GelContactPoint& p : part) {
-      if (p.depth > behind) {
-        part.clear();
-        break;
-      }
-    }
-  }
-  return points;
-}
-
-void HandSim::updateGelContacts() {
-  // As GripperSim::updateGelContacts, for every mounted gel.
-  const btRigidBody& object = *world_->object;
-  const double half_w = config_.gel_width_m / 2, half_h = config_.gel_height_m / 2;
-  for (size_t i = 0; i < world_->gels.size(); ++i) {
-    const btRigidBody& gel = *world_->gels[i];
-    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<int>(i));
-    const Eigen::Isometry3d world_in_gel = gel_in_world.inverse();
-    const Eigen::Vector3d normal_on_object = -gel_in_world.linear().col(2);  // into the gel
-    gel_points_[i] = gelPoints(static_cast<int>(i));
-    for (size_t k = 0; k < gel_points_[i].size(); ++k) {
-      btPersistentManifold& manifold = *world_->manifolds[i][k];
-      manifold.refreshContactPoints(gel.getWorldTransform(), object.getWorldTransform());
-      for (int c = manifold.getNumContacts() - 1; c >= 0; --c) {
-        const Eigen::Vector3d on_object =
-            world_in_gel * toEigen(manifold.getContactPoint(c).m_positionWorldOnB);
-        if (std::abs(on_object.x()) > half_w + kContactBreakingM ||
-            std::abs(on_object.y()) > half_h + kContactBreakingM) {
-          manifold.removeContactPoint(c);
-        }
-      }
-      for (const GelContactPoint& p : spanningContactPoints(gel_points_[i][k])) {
-        const Eigen::Vector3d on_object = gel_in_world * p.position;
-        const Eigen::Vector3d on_gel =
-            gel_in_world * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
-        btManifoldPoint point(gel.getWorldTransform().invXform(toBt(on_gel)),
-                              object.getWorldTransform().invXform(toBt(on_object)),
-                              toBt(normal_on_object), static_cast<btScalar>(-p.depth));
-        point.m_positionWorldOnA = toBt(on_gel);
-        point.m_positionWorldOnB = toBt(on_object);
-        point.m_combinedFriction = static_cast<btScalar>(config_.object.friction);
-        point.m_combinedRestitution = 0;
-        point.m_contactPointFlags |= BT_CONTACT_FLAG_FRICTION_ANCHOR;
-        const int index = manifold.getCacheEntry(point);
-        if (index >= 0) {
-          manifold.replaceContactPoint(point, index);
-        } else {
-          manifold.addManifoldPoint(point);
-        }
-      }
-    }
-  }
-}
-
-void HandSim::updateGelStiffness() {
-  // As GripperSim::updateGelStiffness: the law's secant stiffness at the deepest point, shared
-  // among the points by depth; a lone point gets the patch's torsional friction.
-  const double damping = config_.physics.gel_damping + world_->object->getContactDamping();
-  const double min_half_size = static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0;
-  for (size_t i = 0; i < world_->gels.size(); ++i) {
-    double deepest = 0.0, sum = 0.0;
-    int points = 0;
-    for (btPersistentManifold* manifold : world_->manifolds[i]) {
-      for (int c = 0; c < manifold->getNumContacts(); ++c) {
-        ++points;
-        const double d = -manifold->getContactPoint(c).getDistance();
-        if (d > 0.0) {
-          deepest = std::max(deepest, d);
-          sum += d;
-        }
-      }
-    }
-    const double k = sum > 0.0
-                         ? config_.gel_law.force(std::min(deepest, config_.gel_thickness_m)) / sum
-                         : config_.gel_law.secantStiffness(0.0);
-    world_->gels[i]->setContactStiffnessAndDamping(k, config_.physics.gel_damping);
-    const double patch_radius = points == 1 ? std::sqrt(2.0 * min_half_size * deepest) : 0.0;
-    const btScalar spinning =
-        static_cast<btScalar>(3.0 * M_PI / 16.0 * config_.object.friction * patch_radius);
-    for (btPersistentManifold* manifold : world_->manifolds[i]) {
-      for (int c = 0; c < manifold->getNumContacts(); ++c) {
-        btManifoldPoint& point = manifold->getContactPoint(c);
-        point.m_combinedContactStiffness1 = k;
-        point.m_combinedContactDamping1 = damping;
-        point.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
-        point.m_combinedSpinningFriction = spinning;
-        point.m_combinedRollingFriction = spinning > 0 ? btScalar(1e-9) : btScalar(0);
-      }
-    }
-  }
-}
-
 void HandSim::addLoad(int link, const Eigen::Vector3d& point, const Eigen::Vector3d& force,
                       const Eigen::Vector3d& normal, double normal_stiffness) {
   for (int j : link_joints_[link]) {
@@ -778,45 +625,24 @@ void HandSim::addLoad(int link, const Eigen::Vector3d& point, const Eigen::Vecto
 void HandSim::measureContacts(double dt) {
   std::fill(load_.begin(), load_.end(), 0.0);
   std::fill(contact_stiffness_.begin(), contact_stiffness_.end(), 0.0);
-  const Eigen::Isometry3d object_in_world = objectInWorld();
-  const double deepest_law_point = config_.gel_law.points().back().first;
-  for (size_t i = 0; i < world_->gels.size(); ++i) {
-    const Eigen::Isometry3d gel_in_world = gelInWorld(static_cast<int>(i));
-    GelContactState& state = contacts_[i];
-    state = GelContactState{};
-    state.object_in_gel = gel_in_world.inverse() * object_in_world;
-    gel_points_[i] = gelPoints(static_cast<int>(i));
-    for (const std::vector<GelContactPoint>& part : gel_points_[i]) {
-      for (const GelContactPoint& p : part)
-        state.penetration_m = std::max(state.penetration_m, p.depth);
-    }
-    state.too_deep = state.penetration_m > deepest_law_point;
-    Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
-    const Eigen::Vector3d out_of_gel = gel_in_world.linear().col(2);
-    const double k_gel =
-        config_.gel_law.tangentStiffness(std::min(state.penetration_m, config_.gel_thickness_m));
-    for (btPersistentManifold* manifold : world_->manifolds[i]) {
-      for (int c = 0; c < manifold->getNumContacts(); ++c) {
-        const btManifoldPoint& point = manifold->getContactPoint(c);
-        const double normal = point.getAppliedImpulse() / dt;
-        const Eigen::Vector3d lateral =
-            (toEigen(point.m_lateralFrictionDir1) * point.m_appliedImpulseLateral1 +
-             toEigen(point.m_lateralFrictionDir2) * point.m_appliedImpulseLateral2) /
-            dt;
-        state.normal_force_n += normal;
-        shear_world += lateral;
-        // On the gel: pushed back into itself, and dragged by friction.
-        addLoad(sensor_links_[i], toEigen(point.m_positionWorldOnA), -out_of_gel * normal + lateral,
-                out_of_gel, 0.0);
-      }
-    }
-    // The gel's stiffness as the drive sees it, at the patch's centre: the law's tangent.
-    if (state.penetration_m > 0.0)
-      addLoad(sensor_links_[i], gel_in_world.translation(), Eigen::Vector3d::Zero(), out_of_gel,
-              k_gel);
-    state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
-    state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
-    state.shear_force_n.z() = 0.0;
+  // Each gel contact point loads the joints that carry its link: the gel is pushed back into
+  // itself and dragged by friction.
+  world_->gels->measure(dt, objectInWorld(), contacts_,
+                        [&](int s, const Eigen::Vector3d& on_gel, double normal_n,
+                            const Eigen::Vector3d& friction_n) {
+                          const Eigen::Vector3d out_of_gel =
+                              world_->gels->gelInWorld(s).linear().col(2);
+                          addLoad(sensor_links_[s], on_gel, -out_of_gel * normal_n + friction_n,
+                                  out_of_gel, 0.0);
+                        });
+  // The gel's stiffness as the drive sees it, at the patch's centre: the law's tangent.
+  for (size_t s = 0; s < contacts_.size(); ++s) {
+    const double depth = contacts_[s].penetration_m;
+    if (depth <= 0.0) continue;
+    const Eigen::Isometry3d& gel_in_world = world_->gels->gelInWorld(static_cast<int>(s));
+    addLoad(sensor_links_[s], gel_in_world.translation(), Eigen::Vector3d::Zero(),
+            gel_in_world.linear().col(2),
+            config_.gel_law.tangentStiffness(std::min(depth, config_.gel_thickness_m)));
   }
   // Rigid links against the object: Bullet's own manifolds.
   btDispatcher& dispatcher = world_->dispatcher;
@@ -854,8 +680,8 @@ void HandSim::step(int ticks) {
     advanceBase();
     for (int s = 0; s < substeps; ++s) {
       moveJoints(dt);
-      updateGelContacts();
-      updateGelStiffness();
+      world_->gels->updateContacts();
+      world_->gels->updateStiffness();
       world_->world.stepSimulation(dt, 0, dt);
       measureContacts(dt);
     }
