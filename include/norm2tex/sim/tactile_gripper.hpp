@@ -111,7 +111,6 @@ class TactileGripper {
  private:
   static int index(Finger finger) { return static_cast<int>(finger); }
   void useVariant(int variant);
-  std::string textureKey(int variant) const;
 
   TactileGripperOptions options_;
   std::unique_ptr<GripperSim> sim_;

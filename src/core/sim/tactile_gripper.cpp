@@ -27,37 +27,21 @@ TactileGripper::TactileGripper(GripperSimConfig scene, const SensorModel& sensor
     : options_(options), textures_(std::move(textures)), variant_(options.variant) {
   validate(options_);
   validate(sensor);
-  std::optional<MaterialConfig> material;
-  if (!options_.material_config.empty()) material = loadMaterialConfig(options_.material_config);
-  // As contact_sim: the material's friction unless one is given.
-  scene.object.friction = options_.friction >= 0.0 ? options_.friction
-                          : material               ? material->friction
-                                                   : kDefaultTactileFriction;
-  if (material) scene.object.material = material->name;
+  // As contact_sim and tactile_renderer: the material's friction and beta unless given.
+  const detail::TactileSetup setup = detail::resolveTactileOptions(options_, kDefaultTactileFriction);
+  scene.object.friction = setup.friction;
+  if (setup.material) scene.object.material = setup.material->name;
   setGelFromSensor(sensor, scene);
-  // Whole physics ticks per sensor frame, so every frame is a physics state (as contact_sim).
-  ticks_per_frame_ =
-      std::max(1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
-  scene.physics.rate_hz = ticks_per_frame_ * options_.frame_rate_hz;
+  ticks_per_frame_ = setup.ticks_per_frame;
+  scene.physics.rate_hz = setup.physics_rate_hz;
   sim_ = std::make_unique<GripperSim>(scene);
   mesh_ = std::make_shared<TexturedMesh>(sim_->object().mesh);
   for (auto& renderer : renderers_) renderer = std::make_unique<TactileRenderer>(sensor);
 
-  // As tactile_renderer: the material's beta unless one is given; beta 0 renders textureless
-  // (nothing to generate).
-  beta_mm_ = material ? (options_.beta_mm >= 0.0 ? options_.beta_mm : material->beta_mm) : 0.0;
+  // Beta 0 renders textureless (nothing to generate).
+  beta_mm_ = setup.beta_mm;
   if (beta_mm_ > 0.0) {
     if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(kKeptVariants);
-    if (!mesh_->hasUvs()) {
-      // A mesh without UVs is unwrapped for its texture: done here on this gripper's own mesh,
-      // so that every gripper sharing the cache renders the same (unwrapped) mesh.
-      TextureSource source;
-      source.material_config = options_.material_config;
-      source.variant = variant_;
-      source.seed = options_.material_seed;
-      auto texture = std::make_shared<ObjectTexture>(loadObjectTexture(source, *mesh_));
-      textures_->get(textureKey(variant_), [&] { return *texture; });
-    }
     useVariant(variant_);
   } else {
     for (auto& renderer : renderers_) renderer->setObject(mesh_);
@@ -68,22 +52,10 @@ TactileGripper::TactileGripper(GripperSimConfig scene, const SensorModel& sensor
                            : std::optional<double>(options_.height_offset_m));
 }
 
-std::string TactileGripper::textureKey(int variant) const {
-  return options_.material_config + "#" + std::to_string(options_.material_seed) + "/" +
-         std::to_string(variant);
-}
-
 void TactileGripper::useVariant(int variant) {
-  TextureSource source;
-  source.material_config = options_.material_config;
-  source.variant = variant;
-  source.seed = options_.material_seed;
-  std::shared_ptr<const TexturedMesh> mesh = mesh_;
-  const ObjectTextureCache::Lookup lookup = textures_->get(textureKey(variant), [source, mesh] {
-    TexturedMesh copy = *mesh;  // has UVs: left as it is
-    return loadObjectTexture(source, copy);
-  });
-  for (auto& renderer : renderers_) renderer->setObject(mesh_, lookup.texture->atlas, beta_mm_);
+  const std::shared_ptr<const ObjectTexture> texture = detail::objectTextureVariant(
+      *textures_, options_.material_config, options_.material_seed, variant, mesh_);
+  for (auto& renderer : renderers_) renderer->setObject(mesh_, texture->atlas, beta_mm_);
   variant_ = variant;
 }
 
@@ -103,15 +75,8 @@ void TactileGripper::setVariant(int variant) {
 
 void TactileGripper::prefetchVariant(int variant) {
   if (beta_mm_ <= 0.0 || variant < 0) return;
-  TextureSource source;
-  source.material_config = options_.material_config;
-  source.variant = variant;
-  source.seed = options_.material_seed;
-  std::shared_ptr<const TexturedMesh> mesh = mesh_;
-  textures_->prefetch(textureKey(variant), [source, mesh] {
-    TexturedMesh copy = *mesh;
-    return loadObjectTexture(source, copy);
-  });
+  detail::prefetchObjectTextureVariant(*textures_, options_.material_config, options_.material_seed,
+                                       variant, mesh_);
 }
 
 EpisodeStart TactileGripper::reset(std::uint64_t seed, std::optional<double> height_offset_m) {

@@ -28,20 +28,15 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
     : options_(options), textures_(std::move(textures)), variant_(options.variant) {
   validate(options_);
   validate(sensor);
-  std::optional<MaterialConfig> material;
-  if (!options_.material_config.empty()) material = loadMaterialConfig(options_.material_config);
-  // As TactileGripper: the material's friction unless one is given.
-  config.object.friction = options_.friction >= 0.0 ? options_.friction
-                           : material               ? material->friction
-                                                    : kDefaultTactileFriction;
-  if (material) config.object.material = material->name;
+  // As TactileGripper: the material's friction and beta unless given.
+  const detail::TactileSetup setup = detail::resolveTactileOptions(options_, kDefaultTactileFriction);
+  config.object.friction = setup.friction;
+  if (setup.material) config.object.material = setup.material->name;
   config.gel_width_m = sensor.gel_pad_width_mm * 1e-3;
   config.gel_height_m = sensor.gel_pad_height_mm * 1e-3;
   config.gel_thickness_m = sensor.gel_thickness_mm * 1e-3;
-  // Whole physics ticks per sensor frame, so every frame is a physics state.
-  ticks_per_frame_ =
-      std::max(1, static_cast<int>(std::lround(options_.physics_rate_hz / options_.frame_rate_hz)));
-  config.physics.rate_hz = ticks_per_frame_ * options_.frame_rate_hz;
+  ticks_per_frame_ = setup.ticks_per_frame;
+  config.physics.rate_hz = setup.physics_rate_hz;
   sim_ = std::make_unique<HandSim>(config);
   mesh_ = std::make_shared<TexturedMesh>(sim_->object().mesh);
   for (int s = 0; s < sim_->sensorCount(); ++s) {
@@ -52,31 +47,11 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
   }
   frames_.assign(renderers_.size(), nullptr);
 
-  beta_mm_ = material ? (options_.beta_mm >= 0.0 ? options_.beta_mm : material->beta_mm) : 0.0;
+  beta_mm_ = setup.beta_mm;
   if (beta_mm_ > 0.0) {
     if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(kKeptVariants);
-    TextureSource source;
-    source.material_config = options_.material_config;
-    source.variant = variant_;
-    source.seed = options_.material_seed;
-    const std::string key = options_.material_config + "#" +
-                            std::to_string(options_.material_seed) + "/" + std::to_string(variant_);
-    std::shared_ptr<const ObjectTexture> texture;
-    if (!mesh_->hasUvs()) {
-      // A mesh without UVs is unwrapped for its texture, on this hand's own mesh (as
-      // TactileGripper does), so every sensor renders the unwrapped mesh.
-      auto unwrapped = std::make_shared<ObjectTexture>(loadObjectTexture(source, *mesh_));
-      texture = textures_->get(key, [&] { return *unwrapped; }).texture;
-    } else {
-      std::shared_ptr<const TexturedMesh> mesh = mesh_;
-      texture = textures_
-                    ->get(key,
-                          [source, mesh] {
-                            TexturedMesh copy = *mesh;
-                            return loadObjectTexture(source, copy);
-                          })
-                    .texture;
-    }
+    const std::shared_ptr<const ObjectTexture> texture = detail::objectTextureVariant(
+        *textures_, options_.material_config, options_.material_seed, variant_, mesh_);
     for (auto& renderer : renderers_) renderer->setObject(mesh_, texture->atlas, beta_mm_);
   } else {
     for (auto& renderer : renderers_) renderer->setObject(mesh_);

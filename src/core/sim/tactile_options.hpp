@@ -1,12 +1,19 @@
 #pragma once
 // Private to norm2tex_sim: the options TactileGripper and TactileHand share (rates, material,
-// variant, beta, friction), checked the same way.
+// variant, beta, friction), checked and resolved the same way.
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/materials/material_config.hpp"
+#include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/render/object_texture_cache.hpp"
 
 namespace norm2tex {
 namespace detail {
@@ -42,6 +49,46 @@ void validateTactileOptions(const Options& o, const std::string& what) {
     bad("beta_mm", text(o.beta_mm), "0 or < 0 without a material (nothing to texture)");
   }
 }
+
+/// The shared options resolved as the ROS system resolves them (contact_sim, tactile_renderer).
+struct TactileSetup {
+  std::optional<MaterialConfig> material;
+  /// The given friction, else the material's, else `default_friction`.
+  double friction = 0.0;
+  /// Whole physics ticks per sensor frame, so that every frame is a physics state, and the
+  /// physics rate that makes them whole.
+  int ticks_per_frame = 1;
+  double physics_rate_hz = 0.0;
+  /// The given beta, else the material's; 0 without a material (textureless).
+  double beta_mm = 0.0;
+};
+
+template <typename Options>
+TactileSetup resolveTactileOptions(const Options& o, double default_friction) {
+  TactileSetup setup;
+  if (!o.material_config.empty()) setup.material = loadMaterialConfig(o.material_config);
+  setup.friction = o.friction >= 0.0 ? o.friction
+                   : setup.material  ? setup.material->friction
+                                     : default_friction;
+  setup.ticks_per_frame =
+      std::max(1, static_cast<int>(std::lround(o.physics_rate_hz / o.frame_rate_hz)));
+  setup.physics_rate_hz = setup.ticks_per_frame * o.frame_rate_hz;
+  setup.beta_mm = setup.material ? (o.beta_mm >= 0.0 ? o.beta_mm : setup.material->beta_mm) : 0.0;
+  return setup;
+}
+
+/// Texture variant `variant` of `material_config` (seeded `seed`) on `mesh`, from `cache` (made
+/// once for every simulation sharing it). A mesh without UVs is unwrapped for its texture
+/// first, in place: every renderer of the simulation then draws the unwrapped mesh.
+std::shared_ptr<const ObjectTexture> objectTextureVariant(ObjectTextureCache& cache,
+                                                          const std::string& material_config,
+                                                          std::uint64_t seed, int variant,
+                                                          std::shared_ptr<TexturedMesh>& mesh);
+
+/// Starts generating a variant in the background (see objectTextureVariant); `mesh` has UVs.
+void prefetchObjectTextureVariant(ObjectTextureCache& cache, const std::string& material_config,
+                                  std::uint64_t seed, int variant,
+                                  const std::shared_ptr<const TexturedMesh>& mesh);
 
 }  // namespace detail
 }  // namespace norm2tex
