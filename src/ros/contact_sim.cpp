@@ -31,9 +31,9 @@ namespace norm2tex {
 namespace {
 
 using ros_params::badParameter;
-using ros_params::readParam;
 using ros_params::materialConfigPath;
 using ros_params::packageFile;
+using ros_params::readParam;
 using ros_params::text;
 
 const char* const kSensorNames[2] = {"digit_left", "digit_right"};
@@ -59,44 +59,15 @@ void fillState(const GripperSim& sim, std::int64_t frame, Response& response) {
 
 ContactSimParams readContactSimParams(const ros::NodeHandle& pnh) {
   ContactSimParams p;
-  std::string mode = "real_time";
-  readParam<std::string>(pnh, "mode", mode, mode);
-  if (mode != "real_time" && mode != "synchronous") {
-    badParameter("mode", "'" + mode + "'", "real_time, synchronous");
-  }
-  p.synchronous = mode == "synchronous";
-  readParam<std::string>(pnh, "scene", p.scene, packageFile("config/scenes/cube.yaml"));
-  readParam<std::string>(pnh, "mesh", p.mesh, "");
-  readParam(pnh, "scale", p.scale, p.scale);
-  if (!(p.scale > 0.0 && p.scale <= 1000.0)) badParameter("scale", text(p.scale), "(0, 1000]");
-  readParam<std::string>(pnh, "sensor", p.sensor, packageFile("config/digit.yaml"));
-  readParam<std::string>(pnh, "material", p.material, "wood");
-  if (p.material.empty()) p.material = ros_params::kNoMaterial;
-  if (p.material != ros_params::kNoMaterial) {
-    p.material_config = materialConfigPath(p.material, ", or none (then ~friction)");
-  }
-  readParam(pnh, "friction", p.friction, p.friction);
-  if (!(p.friction < 0.0 || p.friction <= 5.0) || std::isnan(p.friction)) {
-    badParameter("friction", text(p.friction), "[0, 5], or < 0 for the material's");
-  }
+  readSimNodeParams(pnh, p);
   int seed = 0;
   readParam(pnh, "seed", seed, 0);
   if (seed < 0) badParameter("seed", text(seed), ">= 0");
   p.seed = seed;
   readParam(pnh, "height_offset", p.height_offset, std::nan(""));
-  readParam(pnh, "physics_rate", p.physics_rate, p.physics_rate);
-  if (!(p.physics_rate >= 100.0 && p.physics_rate <= 100000.0)) {
-    badParameter("physics_rate", text(p.physics_rate), "[100, 100000] Hz");
-  }
-  readParam(pnh, "frame_rate", p.frame_rate, p.frame_rate);
-  if (!(p.frame_rate >= 1.0 && p.frame_rate <= 1000.0 && p.frame_rate <= p.physics_rate)) {
-    badParameter("frame_rate", text(p.frame_rate), "[1, 1000] Hz and <= ~physics_rate");
-  }
   readParam(pnh, "variant", p.variant, 0);
   if (p.variant < 0) badParameter("variant", text(p.variant), ">= 0");
-  readParam(pnh, "beta", p.beta, -1.0);
   readParam<std::string>(pnh, "scenario", p.scenario, p.scenario);
-  readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
   readParam(pnh, "window", p.window, p.window);
   if (p.window < 1 || p.window > 64) badParameter("window", text(p.window), "[1, 64] frames");
   readParam<std::string>(pnh, "trace_file", p.trace_file, "");
@@ -109,30 +80,14 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
       nh_(nh),
       private_nh_(private_nh) {
   keepFreedMemoryForReuse();  // frames, bags and textures reuse memory, not fault it in
-  std::optional<MaterialConfig> material;
-  if (!params_.material_config.empty()) material = loadMaterialConfig(params_.material_config);
+  SimNodeScene scene = makeSimNodeScene(params_);
   // The labels say what the renderers draw: a material's beta, or a texture file's default.
-  beta_mm_ = params_.beta >= 0.0 ? params_.beta
-             : material          ? material->beta_mm
-                                 : kFileTextureBetaMm;
-  const double friction = params_.friction >= 0.0 ? params_.friction
-                          : material              ? material->friction
-                                                  : kDefaultFriction;
-  const SensorModel sensor = loadSensorModel(params_.sensor);
-  GripperSimConfig config = loadGripperSimConfig(params_.scene);
-  if (!params_.mesh.empty()) {
-    config.object.mesh = params_.mesh;
-    config.object.scale = params_.scale;
-    config.object.name = std::filesystem::path(params_.mesh).stem().string();
-  }
-  config.object.friction = friction;
-  config.object.material = params_.material;
-  setGelFromSensor(sensor, config);
-  // Whole physics ticks per sensor frame, so every frame's stamp is a physics state.
-  ticks_per_frame_ =
-      std::max(1, static_cast<int>(std::lround(params_.physics_rate / params_.frame_rate)));
-  config.physics.rate_hz = ticks_per_frame_ * params_.frame_rate;
-  frame_period_ns_ = std::llround(1e9 / params_.frame_rate);
+  beta_mm_ = scene.beta_mm;
+  const double friction = scene.friction;
+  const SensorModel& sensor = scene.sensor;
+  GripperSimConfig& config = scene.config;
+  ticks_per_frame_ = scene.ticks_per_frame;
+  frame_period_ns_ = scene.frame_period_ns;
   sim_ = std::make_unique<GripperSim>(config);
   {
     // For clients (the Python RosBackend), before the services appear: the offsets ~reset
@@ -167,8 +122,7 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   publishStaticTransforms();
 
   lock_step_ = std::make_unique<LockStep>(
-      private_nh_,
-      params_.synchronous ? params_.renderers : std::vector<std::string>(),
+      private_nh_, params_.synchronous ? params_.renderers : std::vector<std::string>(),
       params_.render_timeout, params_.ready_timeout, "contact_sim", params_.window);
   command_sub_ = nh_.subscribe("gripper/command", 10, &ContactSim::onCommand, this);
   // ~reset and ~step block while the renderers work: they get a thread of their own, so that in
@@ -190,7 +144,12 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
     if (!params_.synchronous || params_.renderers.empty()) publishFrame();
   }
   // Last: the clock's ticks may only come once everything above is in place.
-  if (!params_.synchronous) clock_thread_ = std::thread(&ContactSim::runClock, this);
+  if (!params_.synchronous) {
+    clock_ = std::make_unique<WallClockGrid>(
+        frame_period_ns_,
+        [this](const ros::WallTime& tick, std::int64_t woke_ns) { onTick(tick, woke_ns); },
+        trace_.enabled());
+  }
   ROS_INFO(
       "contact_sim: %s mode, scene %s, material %s (friction %.2f), physics %.0f Hz "
       "(%d ticks per %.1f Hz frame), object '%s' %s",
@@ -198,16 +157,18 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
       params_.material.c_str(), friction, config.physics.rate_hz, ticks_per_frame_,
       params_.frame_rate, config.object.name.c_str(), config.object.mesh.c_str());
   const ObjectCollision& collision = sim_->collision();
-  ROS_INFO("contact_sim: the object collides as %s (%d part%s; its hull bridges hollows %.2f mm "
-           "deep where the gels reach)",
-           collision.kind.c_str(), collision.parts, collision.parts == 1 ? "" : "s",
-           collision.hull_deviation_m * 1e3);
+  ROS_INFO(
+      "contact_sim: the object collides as %s (%d part%s; its hull bridges hollows %.2f mm "
+      "deep where the gels reach)",
+      collision.kind.c_str(), collision.parts, collision.parts == 1 ? "" : "s",
+      collision.hull_deviation_m * 1e3);
   const auto [low, high] = sim_->heightOffsetRange();
   if (low > config.episode.height_offset_low_m || high < config.episode.height_offset_high_m) {
-    ROS_INFO("contact_sim: height offsets %.1f-%.1f mm (the scene's %.1f-%.1f mm where the "
-             "object's sides meet the gel pads)",
-             low * 1e3, high * 1e3, config.episode.height_offset_low_m * 1e3,
-             config.episode.height_offset_high_m * 1e3);
+    ROS_INFO(
+        "contact_sim: height offsets %.1f-%.1f mm (the scene's %.1f-%.1f mm where the "
+        "object's sides meet the gel pads)",
+        low * 1e3, high * 1e3, config.episode.height_offset_low_m * 1e3,
+        config.episode.height_offset_high_m * 1e3);
   }
 }
 
@@ -280,9 +241,10 @@ void ContactSim::publishStateChange(const ros::Time& stamp) {
   if (too_deep && !episode_state_.too_deep) {
     const double deepest = std::max(sim_->contact(Finger::kLeft).penetration_m,
                                     sim_->contact(Finger::kRight).penetration_m);
-    ROS_WARN("contact_sim: episode %u: the object is %.2f mm into a gel, deeper than the gel "
-             "law's table reaches (%.2f mm): its forces are extrapolated",
-             episode_, deepest * 1e3, sim_->config().gel_law.points().back().first * 1e3);
+    ROS_WARN(
+        "contact_sim: episode %u: the object is %.2f mm into a gel, deeper than the gel "
+        "law's table reaches (%.2f mm): its forces are extrapolated",
+        episode_, deepest * 1e3, sim_->config().gel_law.points().back().first * 1e3);
   }
   episode_state_.header.stamp = stamp;
   episode_state_.dropped = sim_->dropped();
@@ -339,9 +301,10 @@ bool ContactSim::onReset(Reset::Request& request, Reset::Response& response) {
     variant = static_cast<int>(request.variant);
     try {
       if (material == ros_params::kNoMaterial || request.variant > 100000) {
-        throw Error("set_texture needs a material of config/materials/ and a variant in [0, "
-                    "100000]; got material '" + material + "', variant " +
-                    std::to_string(request.variant));
+        throw Error(
+            "set_texture needs a material of config/materials/ and a variant in [0, "
+            "100000]; got material '" +
+            material + "', variant " + std::to_string(request.variant));
       }
       const std::string path = materialConfigPath(material);  // throws for an unknown one
       if (!request.next_material.empty()) {
@@ -441,35 +404,11 @@ bool ContactSim::onStep(Step::Request& request, Step::Response& response) {
 }
 
 ContactSim::~ContactSim() {
-  stop_clock_ = true;
+  if (clock_) clock_->requestStop();
   if (lock_step_) lock_step_->cancel();  // a ~step or ~reset may be waiting for the renderers
-  if (clock_thread_.joinable()) clock_thread_.join();
+  clock_.reset();
   service_queue_.disable();  // wakes its spinner at once instead of at its next 0.1 s poll
   if (service_spinner_) service_spinner_->stop();
-}
-
-void ContactSim::runClock() {
-  // Ticks on a fixed grid of absolute times, slept to with clock_nanosleep: one wake-up per
-  // frame, straight into the physics. (A ros::WallTimer went through ROS's timer thread and a
-  // callback queue: two thread hand-overs, ~0.25 ms late at the median here.) ros::WallTime is
-  // CLOCK_REALTIME, so the ticks are wall-clock stamps.
-  const std::int64_t period = frame_period_ns_;
-  std::int64_t next = ros::WallTime::now().toNSec() + period;
-  while (!stop_clock_ && ros::ok()) {
-    timespec when;
-    when.tv_sec = static_cast<time_t>(next / 1'000'000'000);
-    when.tv_nsec = static_cast<long>(next % 1'000'000'000);
-    if (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &when, nullptr) != 0) continue;  // EINTR
-    if (stop_clock_) break;
-    const std::int64_t woke_ns = trace_.enabled() ? FrameTrace::now() : 0;
-    ros::WallTime tick;
-    tick.fromNSec(static_cast<std::uint64_t>(next));
-    onTick(tick, woke_ns);
-    next += period;
-    // Far behind (a stalled machine): onTick has let the missed frames go; so does the grid.
-    const std::int64_t now = ros::WallTime::now().toNSec();
-    if (next < now - 4 * period) next += ((now - next) / period) * period;
-  }
 }
 
 void ContactSim::onTick(const ros::WallTime& tick_time, std::int64_t woke_ns) {

@@ -22,36 +22,18 @@
 #include "norm2tex/Step.h"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
+#include "sim_node_params.hpp"
+#include "wall_clock_grid.hpp"
 
 namespace norm2tex {
 
-/// Validated private parameters of contact_sim (docs/ros.md, "contact_sim").
-struct ContactSimParams {
-  bool synchronous = false;      ///< ~mode: "real_time" | "synchronous"
-  std::string scene;             ///< ~scene: scene yaml
-  std::string mesh;              ///< ~mesh: replaces the scene's object mesh when set
-  double scale = 1.0;            ///< ~scale of ~mesh (0.001 for millimetres)
-  std::string sensor;            ///< ~sensor: sensor yaml (gel size and thickness)
-  /// ~material: config/materials/<material>.yaml gives the friction and beta; "none": no
-  /// material (the renderers use a texture file or the mesh's own texture)
-  std::string material;
-  std::string material_config;   ///< the yaml resolved from ~material; "" for none
-  /// ~friction: Coulomb coefficient against the gels; < 0: the material's (kDefaultFriction
-  /// with ~material none)
-  double friction = -1.0;
-  std::int64_t seed = 0;         ///< ~seed: seed of the first episode
-  double height_offset = 0;      ///< ~height_offset [m] of the first episode, NaN = random
-  double physics_rate = 1000.0;  ///< ~physics_rate [Hz], rounded to whole ticks per frame
-  double frame_rate = 60.0;      ///< ~frame_rate [Hz]: sensor frames (TF, contacts, clock)
-  int variant = 0;               ///< ~variant: texture variant, a label for EpisodeInfo
-  double beta = -1;              ///< ~beta [mm], label; < 0: the material's beta_mm
+/// Validated private parameters of contact_sim (docs/ros.md, "contact_sim"): the simulation
+/// nodes' (SimNodeParams) and these.
+struct ContactSimParams : SimNodeParams {
+  std::int64_t seed = 0;           ///< ~seed: seed of the first episode
+  double height_offset = 0;        ///< ~height_offset [m] of the first episode, NaN = random
+  int variant = 0;                 ///< ~variant: texture variant, a label for EpisodeInfo
   std::string scenario = "grasp";  ///< ~scenario: label
-  /// ~renderers: sensors whose FrameRendered each synchronous frame waits for (e.g.
-  /// [digit_left, digit_right]); empty: none.
-  std::vector<std::string> renderers;
-  double render_timeout = 5.0;  ///< ~render_timeout [s of wall time] for each FrameRendered
-  /// ~ready_timeout [s of wall time] for the renderers to start (texture bakes included)
-  double ready_timeout = 60.0;
   /// ~window: frames of one ~step in flight at once: the physics of the next frame runs while
   /// the renderers draw this one. Every ~step and ~reset still returns only once all of its
   /// frames are answered (1 = strict lock-step within a step too).
@@ -60,9 +42,6 @@ struct ContactSimParams {
   /// shutdown (scripts/ros_benchmark --trace); "" = none.
   std::string trace_file;
 };
-
-/// Friction against the gels with ~material none and no ~friction (the scene default's).
-constexpr double kDefaultFriction = 0.5;
 
 /// Reads and validates the private parameters; throws Error naming the parameter and its valid
 /// range (or the file) at fault.
@@ -83,10 +62,8 @@ class ContactSim {
   void onCommand(const GripperCommand::ConstPtr& msg);
   bool onReset(Reset::Request& request, Reset::Response& response);
   bool onStep(Step::Request& request, Step::Response& response);
-  /// Real time: sleeps to each frame period's tick (absolute wall-clock time) and handles it on
-  /// its own thread.
-  void runClock();
-  /// `woke_ns`: when the clock thread woke for it (for the trace).
+  /// Real time: a frame period's tick of the clock (WallClockGrid); `woke_ns`: when the clock
+  /// thread woke for it (for the trace).
   void onTick(const ros::WallTime& tick, std::int64_t woke_ns);
 
   /// Applies a command; false (and a throttled warning, nothing changed) when it is invalid.
@@ -154,8 +131,7 @@ class ContactSim {
   // Last: destroyed (stopped and joined) first, while everything its callbacks use exists.
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
   /// Real time: the frame clock (a thread woken at each tick; joined by the destructor).
-  std::atomic<bool> stop_clock_{false};
-  std::thread clock_thread_;
+  std::unique_ptr<WallClockGrid> clock_;
 };
 
 }  // namespace norm2tex

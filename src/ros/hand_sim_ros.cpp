@@ -49,68 +49,28 @@ Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, const std::string
 
 HandSimParams readHandSimParams(const ros::NodeHandle& pnh) {
   HandSimParams p;
-  std::string mode = "real_time";
-  readParam<std::string>(pnh, "mode", mode, mode);
-  if (mode != "real_time" && mode != "synchronous") {
-    badParameter("mode", "'" + mode + "'", "real_time, synchronous");
-  }
-  p.synchronous = mode == "synchronous";
+  readSimNodeParams(pnh, p);
   readParam<std::string>(pnh, "hand", p.hand, "");
   if (p.hand.empty()) badParameter("hand", "''", "a hand yaml (docs/hands.md)");
-  readParam<std::string>(pnh, "scene", p.scene, packageFile("config/scenes/cube.yaml"));
-  readParam<std::string>(pnh, "mesh", p.mesh, "");
-  readParam(pnh, "scale", p.scale, p.scale);
-  if (!(p.scale > 0.0 && p.scale <= 1000.0)) badParameter("scale", text(p.scale), "(0, 1000]");
-  readParam<std::string>(pnh, "sensor", p.sensor, packageFile("config/digit.yaml"));
-  readParam<std::string>(pnh, "material", p.material, "wood");
-  if (p.material.empty()) p.material = ros_params::kNoMaterial;
-  readParam(pnh, "friction", p.friction, p.friction);
-  if (!(p.friction < 0.0 || p.friction <= 5.0) || std::isnan(p.friction)) {
-    badParameter("friction", text(p.friction), "[0, 5], or < 0 for the material's");
-  }
   readParam(pnh, "object_pose", p.object_pose, p.object_pose);
   if (p.object_pose.size() != 6 || !std::all_of(p.object_pose.begin(), p.object_pose.end(),
                                                 [](double v) { return std::isfinite(v); })) {
     badParameter("object_pose", std::to_string(p.object_pose.size()) + " values",
                  "[x, y, z, roll, pitch, yaw], finite, m and rad");
   }
-  readParam(pnh, "physics_rate", p.physics_rate, p.physics_rate);
-  if (!(p.physics_rate >= 100.0 && p.physics_rate <= 100000.0)) {
-    badParameter("physics_rate", text(p.physics_rate), "[100, 100000] Hz");
-  }
-  readParam(pnh, "frame_rate", p.frame_rate, p.frame_rate);
-  if (!(p.frame_rate >= 1.0 && p.frame_rate <= 1000.0 && p.frame_rate <= p.physics_rate)) {
-    badParameter("frame_rate", text(p.frame_rate), "[1, 1000] Hz and <= ~physics_rate");
-  }
   p.renderers_given = pnh.hasParam("renderers");
-  readLockStepParams(pnh, p.renderers, p.render_timeout, p.ready_timeout);
   return p;
 }
 
 HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : params_(readHandSimParams(private_nh)), nh_(nh), private_nh_(private_nh) {
-  GripperSimConfig scene = loadGripperSimConfig(params_.scene);
-  if (!params_.mesh.empty()) {
-    scene.object.mesh = params_.mesh;
-    scene.object.scale = params_.scale;
-    scene.object.name = std::filesystem::path(params_.mesh).stem().string();
-  }
-  if (params_.material != ros_params::kNoMaterial) {
-    const MaterialConfig material =
-        loadMaterialConfig(materialConfigPath(params_.material, ", or none"));
-    scene.object.friction = material.friction;
-    beta_mm_ = material.beta_mm;
-  }
-  if (params_.friction >= 0.0) scene.object.friction = params_.friction;
-  scene.object.material = params_.material;
-  const SensorModel sensor = loadSensorModel(params_.sensor);
-  setGelFromSensor(sensor, scene);
-  HandSimConfig config = makeHandSimConfig(params_.hand, scene);
+  const SimNodeScene scene = makeSimNodeScene(params_);
+  beta_mm_ = scene.beta_mm;
+  HandSimConfig config = makeHandSimConfig(params_.hand, scene.config);
   config.object_pose = poseFromXyzRpy(params_.object_pose);
-  ticks_per_frame_ =
-      std::max(1, static_cast<int>(std::lround(params_.physics_rate / params_.frame_rate)));
-  config.physics.rate_hz = ticks_per_frame_ * params_.frame_rate;
-  frame_period_ns_ = std::llround(1e9 / params_.frame_rate);
+  ticks_per_frame_ = scene.ticks_per_frame;
+  frame_period_ns_ = scene.frame_period_ns;
+  const SensorModel& sensor = scene.sensor;
   sim_ = std::make_unique<HandSim>(config);
   for (const std::string& warning : sim_->warnings()) ROS_WARN("hand_sim: %s", warning.c_str());
   if (!params_.renderers_given) {
@@ -169,7 +129,11 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
     std::lock_guard<std::mutex> lock(mutex_);
     if (!params_.synchronous || params_.renderers.empty()) publishFrame();
   }
-  if (!params_.synchronous) clock_thread_ = std::thread(&HandSimRos::runClock, this);
+  if (!params_.synchronous) {
+    clock_ = std::make_unique<WallClockGrid>(
+        frame_period_ns_,
+        [this](const ros::WallTime& scheduled, std::int64_t) { onTick(scheduled); });
+  }
   ROS_INFO(
       "hand_sim: %s mode, hand '%s' (%zu links, %zu actuated joints, %d sensors) from %s, "
       "object '%s', physics %.0f Hz (%d ticks per %.1f Hz frame)",
@@ -180,9 +144,9 @@ HandSimRos::HandSimRos(ros::NodeHandle nh, ros::NodeHandle private_nh)
 }
 
 HandSimRos::~HandSimRos() {
-  stop_clock_ = true;
+  if (clock_) clock_->requestStop();
   if (lock_step_) lock_step_->cancel();
-  if (clock_thread_.joinable()) clock_thread_.join();
+  clock_.reset();
   service_queue_.disable();
   if (service_spinner_) service_spinner_->stop();
 }
@@ -418,28 +382,16 @@ bool HandSimRos::onStep(HandStep::Request& request, HandStep::Response& response
   return true;
 }
 
-void HandSimRos::runClock() {
-  // As contact_sim's clock: absolute ticks on a wall-clock grid, a few frames of catch-up.
-  const std::int64_t period = frame_period_ns_;
-  std::int64_t next = ros::WallTime::now().toNSec() + period;
-  while (!stop_clock_ && ros::ok()) {
-    timespec when;
-    when.tv_sec = static_cast<time_t>(next / 1'000'000'000);
-    when.tv_nsec = static_cast<long>(next % 1'000'000'000);
-    if (clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &when, nullptr) != 0) continue;
-    if (stop_clock_) break;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      sim_->step(ticks_per_frame_);
-      ++frame_;
-      publishFrame();
-    }
-    next += period;
-    const std::int64_t now = ros::WallTime::now().toNSec();
-    if (next < now - 4 * period) {
-      ROS_WARN_THROTTLE(5.0, "hand_sim: behind real time; skipping frames");
-      next += ((now - next) / period) * period;
-    }
+void HandSimRos::onTick(const ros::WallTime& scheduled) {
+  // One frame a tick; a tick that ran late is not made up (the frames it missed are skipped).
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sim_->step(ticks_per_frame_);
+    ++frame_;
+    publishFrame();
+  }
+  if ((ros::WallTime::now() - scheduled).toNSec() > 4 * frame_period_ns_) {
+    ROS_WARN_THROTTLE(5.0, "hand_sim: behind real time; skipping frames");
   }
 }
 

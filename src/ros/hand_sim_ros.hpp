@@ -21,28 +21,17 @@
 #include "norm2tex/HandStep.h"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/hand_sim.hpp"
+#include "sim_node_params.hpp"
+#include "wall_clock_grid.hpp"
 
 namespace norm2tex {
 
-/// Validated private parameters of hand_sim (docs/ros.md, "hand_sim").
-struct HandSimParams {
-  bool synchronous = false;  ///< ~mode: "real_time" | "synchronous"
-  std::string hand;          ///< ~hand: the hand yaml (docs/hands.md)
-  std::string scene;         ///< ~scene: scene yaml for the object, physics and gel law
-  std::string mesh;          ///< ~mesh: replaces the scene's object mesh when set
-  double scale = 1.0;        ///< ~scale of ~mesh
-  std::string sensor;        ///< ~sensor: sensor yaml (gel pad and thickness)
-  std::string material;      ///< ~material: its friction; "none": ~friction
-  double friction = -1.0;    ///< ~friction; < 0: the material's
+/// Validated private parameters of hand_sim (docs/ros.md, "hand_sim"): the simulation nodes'
+/// (SimNodeParams; ~renderers absent: every sensor of the hand yaml) and these.
+struct HandSimParams : SimNodeParams {
+  std::string hand;  ///< ~hand: the hand yaml (docs/hands.md)
   std::vector<double> object_pose{0.0, 0.0, 0.1, 0.0, 0.0, 0.0};  ///< ~object_pose [x y z r p y]
-  double physics_rate = 1000.0;  ///< ~physics_rate [Hz], whole ticks per frame
-  double frame_rate = 60.0;      ///< ~frame_rate [Hz]
-  /// ~renderers: the sensors whose FrameRendered each synchronous frame waits for; absent: every
-  /// sensor of the hand yaml.
-  std::vector<std::string> renderers;
-  bool renderers_given = false;
-  double render_timeout = 5.0;
-  double ready_timeout = 60.0;
+  bool renderers_given = false;                                   ///< whether ~renderers was set
 };
 
 /// Reads and validates the private parameters; throws Error naming the one at fault.
@@ -71,7 +60,8 @@ class HandSimRos {
   bool onReset(HandReset::Request& request, HandReset::Response& response);
   bool onStep(HandStep::Request& request, HandStep::Response& response);
   void warnClamped(const std::vector<std::string>& clamped);
-  void runClock();
+  /// Real time: a frame period's tick of the clock (WallClockGrid).
+  void onTick(const ros::WallTime& scheduled);
   void publishStaticTransforms();
   /// The episode's labels on /episode (latched), at start and at every ~reset: what a recording
   /// names its images with.
@@ -101,8 +91,7 @@ class HandSimRos {
   ros::ServiceServer reset_srv_, step_srv_;
   std::unique_ptr<LockStep> lock_step_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
-  std::atomic<bool> stop_clock_{false};
-  std::thread clock_thread_;
+  std::unique_ptr<WallClockGrid> clock_;
 };
 
 }  // namespace norm2tex

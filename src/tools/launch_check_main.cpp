@@ -16,6 +16,7 @@
 #include "cli_arguments.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/output_directory.hpp"
+#include "norm2tex/mesh/object_mesh.hpp"
 
 namespace {
 
@@ -31,7 +32,8 @@ void checkInputFile(const std::string& what_and_path) {
   }
   const std::string what = what_and_path.substr(0, eq);
   const std::string path = what_and_path.substr(eq + 1);
-  if (path.empty()) return;
+  // Empty: not given; a mesh may be a primitive ("sphere:45"), made, not read.
+  if (path.empty() || (what == "mesh" && norm2tex::isPrimitiveMeshSpec(path))) return;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     throw norm2tex::Error(what + " file '" + path + "' does not exist");
@@ -47,8 +49,8 @@ void checkInputFile(const std::string& what_and_path) {
 int main(int argc, char** argv) {
   std::string launch = "norm2tex_launch_check";
   try {
-    const norm2tex::cli::Arguments args(argc, argv,
-                                        {"--launch", "--output-dir", "--min-free-mb", "--file"}, {});
+    const norm2tex::cli::Arguments args(
+        argc, argv, {"--launch", "--output-dir", "--min-free-mb", "--file"}, {});
     launch = args.value("--launch", launch);
     if (!args.positional().empty()) {
       throw norm2tex::cli::UsageError("unexpected argument '" + args.positional().front() + "'");

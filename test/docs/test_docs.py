@@ -38,7 +38,8 @@ NODE_SOURCES = {
     "nodelet_group": ["nodelet_group_main.cpp"],
 }
 # Readers shared by several nodes: included where a node's source calls them.
-SHARED_READERS = {"readLockStepParams": "lock_step.cpp"}
+# (Followed through: a shared reader may call another.)
+SHARED_READERS = {"readLockStepParams": "lock_step.cpp", "readSimNodeParams": "sim_node_params.cpp"}
 
 
 def read(path):
@@ -299,12 +300,17 @@ def code_params(ros_dir):
     out = {}
     for node, files in NODE_SOURCES.items():
         params = set()
-        for f in files:
+        sources, seen = list(files), set()
+        while sources:
+            f = sources.pop()
+            if f in seen:
+                continue
+            seen.add(f)
             params |= reads.get(f, set())
             text = read(os.path.join(ros_dir, f))
             for reader, shared in SHARED_READERS.items():
                 if re.search(r"\b%s\s*\(" % reader, text):
-                    params |= reads.get(shared, set())
+                    sources.append(shared)
         out[node] = params
     owned = {f for files in NODE_SOURCES.values() for f in files} | set(SHARED_READERS.values())
     unowned = sorted(f for f, names in reads.items() if names and f not in owned)

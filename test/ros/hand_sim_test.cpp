@@ -3,6 +3,7 @@
 // a simulator publishes it, refusals. Waits on conditions with deadlines, never sleeps.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -17,6 +18,8 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 #include <trajectory_msgs/JointTrajectory.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "norm2tex/EpisodeInfo.h"
 #include "norm2tex/GripperCommand.h"
@@ -239,6 +242,59 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   ASSERT_TRUE(hand.step.call(zero));
   EXPECT_FALSE(zero.response.success);
   EXPECT_NE(zero.response.message.find("frames = 0 refused"), std::string::npos);
+}
+
+TEST(HandSimTexture, ANormalMapWithoutMaterialTexturesTheGraspAndLabelsTheEpisode) {
+  // hand_sim_texture.test: normal_map:= with material:=none and beta:=0.3; digit_left_bare
+  // renders digit_left's contact without texture.
+  Hand hand;
+  std::map<std::string, std::map<ros::Time, sensor_msgs::Image::ConstPtr>> image;
+  std::vector<ros::Subscriber> subs;
+  for (const std::string s : {"digit_left", "digit_left_bare"}) {
+    subs.push_back(hand.nh.subscribe<sensor_msgs::Image>(
+        s + "/image_raw", 100, [&, s](const auto& m) { image[s][m->header.stamp] = m; }));
+  }
+  norm2tex::EpisodeInfo::ConstPtr episode;
+  ros::Subscriber episode_sub =
+      hand.nh.subscribe<norm2tex::EpisodeInfo>("/episode", 1, [&](const auto& m) { episode = m; });
+  ASSERT_TRUE(waitFor([&] { return subs[1].getNumPublishers() > 0 && episode; }, 60.0));
+  EXPECT_EQ(episode->material, "none");
+  EXPECT_DOUBLE_EQ(episode->beta, 0.3);  // the given beta, not a material's
+
+  const auto view = [](const sensor_msgs::Image& m) {
+    return cv::Mat(static_cast<int>(m.height), static_cast<int>(m.width), CV_8UC3,
+                   const_cast<std::uint8_t*>(m.data.data()), m.step);
+  };
+  // |textured - bare| in grey levels at a step's stamp.
+  const auto difference = [&](const ros::Time& t) {
+    EXPECT_TRUE(waitFor(
+        [&] { return image["digit_left"].count(t) && image["digit_left_bare"].count(t); }, 10.0));
+    if (!image["digit_left"].count(t) || !image["digit_left_bare"].count(t)) return cv::Mat();
+    cv::Mat diff, grey;
+    cv::absdiff(view(*image["digit_left"][t]), view(*image["digit_left_bare"][t]), diff);
+    cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+    return grey;
+  };
+  // Open, nothing touches: the texture is not drawn (the same background and noise seed).
+  const auto open = hand.stepFrames(1);
+  ASSERT_FALSE(open.in_contact[0]);
+  const cv::Mat untouched = difference(open.stamp);
+  ASSERT_FALSE(untouched.empty());
+  EXPECT_EQ(cv::countNonZero(untouched), 0);
+
+  // Held at the drives' 10 N: the cube's face presses the middle of the gel, and its relief shows.
+  hand.send(closing(-0.016, 0.016, 1.0));
+  const auto held = hand.stepFrames(90);
+  ASSERT_TRUE(held.in_contact[0]);
+  const cv::Mat touched = difference(held.stamp);
+  ASSERT_FALSE(touched.empty());
+  const cv::Rect middle(touched.cols / 4, touched.rows / 4, touched.cols / 2, touched.rows / 2);
+  EXPECT_GT(cv::mean(touched(middle))[0], 1.0);
+
+  std::string normal_map;
+  if (hand.nh.getParam("/hand_texture_test/normal_map", normal_map)) {
+    std::remove(normal_map.c_str());
+  }
 }
 
 }  // namespace

@@ -29,9 +29,9 @@ const fs::path& scratch() {
 
 int freePort() {
   std::string output;
-  EXPECT_EQ(norm2tex::test::runCommand(std::string(NORM2TEX_SOURCE_DIR) + "/scripts/free_port",
-                                       output),
-            0)
+  EXPECT_EQ(
+      norm2tex::test::runCommand(std::string(NORM2TEX_SOURCE_DIR) + "/scripts/free_port", output),
+      0)
       << output;
   return std::stoi(output);
 }
@@ -79,8 +79,9 @@ TEST(LaunchFailure, AnOutputDirectoryThatCannotBeWrittenEndsTheLaunchAtOnceWithT
       {(file / "out").string(), "record_dataset.launch: output directory '" +
                                     (file / "out").string() +
                                     "' cannot be written: Not a directory"},
-      {"/proc/norm2tex_cannot_write", "record_dataset.launch: output directory "
-                                      "'/proc/norm2tex_cannot_write' cannot be written"},
+      {"/proc/norm2tex_cannot_write",
+       "record_dataset.launch: output directory "
+       "'/proc/norm2tex_cannot_write' cannot be written"},
   };
   for (const Case& c : cases) {
     const LaunchRun run = launch("record_dataset.launch samples:=10 out:=" + c.out);
@@ -97,32 +98,42 @@ TEST(LaunchFailure, AMissingFileEndsTheLaunchAtOnceWithTheReason) {
   const LaunchRun run = launch("gripper_sim.launch mesh:=" + missing + " scale:=0.001");
   EXPECT_NE(run.status, 0) << run.output;
   EXPECT_LT(run.seconds, kEndsBySelfSeconds) << run.output;
-  EXPECT_TRUE(hasLine(run.output, "gripper_sim.launch: mesh file '" + missing +
-                                      "' does not exist"))
+  EXPECT_TRUE(hasLine(run.output, "gripper_sim.launch: mesh file '" + missing + "' does not exist"))
       << run.output;
   const std::string no_map = (scratch() / "no_such_normals.png").string();
   const LaunchRun map_run = launch("gripper_sim.launch material:=none normal_map:=" + no_map);
   EXPECT_NE(map_run.status, 0) << map_run.output;
-  EXPECT_TRUE(hasLine(map_run.output, "gripper_sim.launch: normal_map file '" + no_map +
-                                          "' does not exist"))
+  EXPECT_TRUE(hasLine(map_run.output,
+                      "gripper_sim.launch: normal_map file '" + no_map + "' does not exist"))
       << map_run.output;
 }
 
 TEST(LaunchFailure, ABadHandEndsHandSimLaunchWithTheReason) {
-  // An unreadable hand yaml stops roslaunch while it reads the file (scripts/hand_nodelets);
-  // what only the simulation finds (a sensor on a link the URDF lacks, a malformed URDF) ends it
-  // through the required manager, with hand_sim's FATAL naming it.
+  // A missing hand yaml (norm2tex_launch_check) or one without sensors (scripts/hand_nodelets)
+  // stops roslaunch while it reads the file; what only the simulation finds (a sensor on a link
+  // the URDF lacks, a malformed URDF) ends it through the required manager, with hand_sim's
+  // FATAL naming it.
   const std::string robots = std::string(NORM2TEX_SOURCE_DIR) + "/test/fixtures/robots/wsg50";
   const std::string missing = (scratch() / "no_such_hand.yaml").string();
   const LaunchRun run = launch("hand_sim.launch hand:=" + missing);
   EXPECT_NE(run.status, 0) << run.output;
   EXPECT_LT(run.seconds, kEndsBySelfSeconds) << run.output;
-  EXPECT_NE(run.output.find("hand_nodelets: hand yaml '" + missing + "'"), std::string::npos)
+  EXPECT_NE(run.output.find("hand_sim.launch: hand file '" + missing + "' does not exist"),
+            std::string::npos)
       << run.output;
+  const fs::path no_sensors = scratch() / "no_sensors.yaml";
+  std::ofstream(no_sensors) << "hand: {urdf: " << robots << "/wsg50_digit.urdf}\n";
+  const LaunchRun sensors_run = launch("hand_sim.launch hand:=" + no_sensors.string());
+  EXPECT_NE(sensors_run.status, 0) << sensors_run.output;
+  EXPECT_NE(sensors_run.output.find("hand_nodelets: hand yaml '" + no_sensors.string() +
+                                    "': sensors is required"),
+            std::string::npos)
+      << sensors_run.output;
 
   const fs::path link = scratch() / "bad_link.yaml";
-  std::ofstream(link) << "hand: {urdf: " << robots << "/wsg50_digit.urdf, package_paths: {wsg50: "
-                      << robots << "}}\nsensors: [{name: digit_left, link: finger_left_tipp}]\n";
+  std::ofstream(link) << "hand: {urdf: " << robots
+                      << "/wsg50_digit.urdf, package_paths: {wsg50: " << robots
+                      << "}}\nsensors: [{name: digit_left, link: finger_left_tipp}]\n";
   const LaunchRun link_run = launch("hand_sim.launch mode:=synchronous hand:=" + link.string());
   EXPECT_LT(link_run.seconds, kEndsBySelfSeconds) << link_run.output;
   EXPECT_NE(link_run.output.find("sensor 'digit_left': link 'finger_left_tipp' is not in the hand"),
@@ -154,8 +165,7 @@ TEST(LaunchFailure, ANodeletThatFailsAtStartUpEndsTheLaunchWithoutWaitingForTheO
   EXPECT_NE(run.output.find("~compression = 'zip' is not valid; valid: lz4, bz2, none"),
             std::string::npos)
       << run.output;
-  EXPECT_NE(run.output.find("REQUIRED process [norm2tex_manager"), std::string::npos)
-      << run.output;
+  EXPECT_NE(run.output.find("REQUIRED process [norm2tex_manager"), std::string::npos) << run.output;
 }
 
 TEST(LaunchEnd, AFinishedRecordingEndsTheLaunchQuietly) {

@@ -33,4 +33,7 @@ const char* shapeName(ObjectMesh::Shape shape);
 /// Error naming the file, or the spec and its valid form.
 ObjectMesh loadObjectMesh(const std::string& spec, double scale = 1.0);
 
+/// Whether `spec` names a primitive ("box:...", "sphere:...") rather than a mesh file.
+bool isPrimitiveMeshSpec(const std::string& spec);
+
 }  // namespace norm2tex

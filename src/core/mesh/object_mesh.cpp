@@ -48,8 +48,8 @@ bool fitRoundPrimitive(ObjectMesh& out) {
   for (const Eigen::Vector3f& v : mesh.vertices()) {
     radius = std::max(radius, (v.cast<double>() - centre).norm());
   }
-  const bool on_sphere = std::all_of(
-      mesh.vertices().begin(), mesh.vertices().end(), [&](const Eigen::Vector3f& v) {
+  const bool on_sphere =
+      std::all_of(mesh.vertices().begin(), mesh.vertices().end(), [&](const Eigen::Vector3f& v) {
         return std::abs((v.cast<double>() - centre).norm() - radius) <= tolerance;
       });
   if (on_sphere && size.maxCoeff() - size.minCoeff() <= 0.02 * size.maxCoeff()) {
@@ -75,7 +75,8 @@ bool fitRoundPrimitive(ObjectMesh& out) {
       const bool on_side = std::abs(rho - r) <= tolerance;
       if (!on_side && std::abs(std::abs(h) - half_height) > tolerance) cylinder = false;
       if (on_side) {
-        rim_angles.insert(std::lround(std::atan2(v[j] - centre[j], v[i] - centre[i]) * 1800 / M_PI));
+        rim_angles.insert(
+            std::lround(std::atan2(v[j] - centre[j], v[i] - centre[i]) * 1800 / M_PI));
       }
       // Capsule: each vertex at the radius from its spine, the segment along the axis.
       const double along = std::clamp(h, -spine, spine);
@@ -95,6 +96,10 @@ bool fitRoundPrimitive(ObjectMesh& out) {
 }
 
 }  // namespace
+
+bool isPrimitiveMeshSpec(const std::string& spec) {
+  return spec.rfind("sphere:", 0) == 0 || spec.rfind("box:", 0) == 0;
+}
 
 ObjectMesh loadObjectMesh(const std::string& spec, double scale) {
   ObjectMesh out;
@@ -134,11 +139,16 @@ ObjectMesh loadObjectMesh(const std::string& spec, double scale) {
 
 const char* shapeName(ObjectMesh::Shape shape) {
   switch (shape) {
-    case ObjectMesh::Shape::kBox: return "box";
-    case ObjectMesh::Shape::kSphere: return "sphere";
-    case ObjectMesh::Shape::kCylinder: return "cylinder";
-    case ObjectMesh::Shape::kCapsule: return "capsule";
-    case ObjectMesh::Shape::kMesh: break;
+    case ObjectMesh::Shape::kBox:
+      return "box";
+    case ObjectMesh::Shape::kSphere:
+      return "sphere";
+    case ObjectMesh::Shape::kCylinder:
+      return "cylinder";
+    case ObjectMesh::Shape::kCapsule:
+      return "capsule";
+    case ObjectMesh::Shape::kMesh:
+      break;
   }
   return "mesh";
 }

@@ -63,7 +63,8 @@ void GelPadContacts::place(int index, const Eigen::Isometry3d& gel_in_world) {
   pad.gel_in_world = gel_in_world;
   // The box's centre sits half a thickness behind the gel surface (gel -z). Kinematic bodies:
   // Bullet derives their velocity from the change of this transform.
-  const Eigen::Isometry3d box = gel_in_world * Eigen::Translation3d(0, 0, -options_.thickness_m / 2);
+  const Eigen::Isometry3d box =
+      gel_in_world * Eigen::Translation3d(0, 0, -options_.thickness_m / 2);
   pad.body->setWorldTransform(toBt(box));
   pad.body->setInterpolationWorldTransform(pad.body->getWorldTransform());
 }
@@ -219,7 +220,8 @@ void GelPadContacts::measure(double dt, const Eigen::Isometry3d& object_in_world
     pad.points_valid = true;
     pad.points_gel_in_world = gel_in_world;
     for (const std::vector<GelContactPoint>& part : pad.points) {
-      for (const GelContactPoint& p : part) state.penetration_m = std::max(state.penetration_m, p.depth);
+      for (const GelContactPoint& p : part)
+        state.penetration_m = std::max(state.penetration_m, p.depth);
     }
     state.too_deep = state.penetration_m > deepest_law_point;
     Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();

@@ -34,6 +34,21 @@ struct GelPadOptions {
   double behind_gel_m = 0.0;
 };
 
+/// The options of a simulation's config (GripperSimConfig, HandSimConfig: gel pad, object
+/// friction, physics, gel law) for an object of smallest extent 2 x `object_min_half_size_m`.
+template <typename Config>
+GelPadOptions gelPadOptionsOf(const Config& config, double object_min_half_size_m) {
+  GelPadOptions pads;
+  pads.width_m = config.gel_width_m;
+  pads.height_m = config.gel_height_m;
+  pads.thickness_m = config.gel_thickness_m;
+  pads.friction = config.object.friction;
+  pads.damping = config.physics.gel_damping;
+  pads.law = config.gel_law;
+  pads.object_min_half_size_m = object_min_half_size_m;
+  return pads;
+}
+
 /// What the object touches the gels with, in its body frame: convex parts, or one capsule.
 struct GelContactGeometry {
   const std::vector<ConvexPolytope>* parts = nullptr;

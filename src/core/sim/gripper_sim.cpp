@@ -73,8 +73,8 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
             << " mm wide along the grip axis: the closed gripper (gripper.min_gap_mm = "
-            << config_.gripper.min_gap_m * 1e3 << ") cannot indent both gels "
-            << grip_depth * 1e3 << " mm into it";
+            << config_.gripper.min_gap_m * 1e3 << ") cannot indent both gels " << grip_depth * 1e3
+            << " mm into it";
     if (grip_reach > grip_depth) {
       message << " (its drive would have to close " << (grip_reach - grip_depth) * 1e3
               << " mm further on each side: gripper.stiffness_n_per_mm)";
@@ -125,15 +125,15 @@ void GripperSim::findHeightOffsetRange(const Eigen::Vector3d& centre) {
     // kMinPadOverlap, or the gels would meet it only at their very rim.
     low = std::max(low, -pad - z_hi + kMinPadOverlap);
     high = std::min(high, pad - z_lo - kMinPadOverlap);
-    sides << (side > 0 ? "" : ", ") << (side > 0 ? "+y" : "-y") << " side " << z_lo * 1e3
-          << " to " << z_hi * 1e3;
+    sides << (side > 0 ? "" : ", ") << (side > 0 ? "+y" : "-y") << " side " << z_lo * 1e3 << " to "
+          << z_hi * 1e3;
   }
   if (low > high) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh
             << "' cannot be gripped at any height offset of episode.height_offset_mm ["
-            << e.height_offset_low_m * 1e3 << ", " << e.height_offset_high_m * 1e3
-            << "]: within " << reach * 1e3 << " mm of its extent along the grip axis its sides span"
+            << e.height_offset_low_m * 1e3 << ", " << e.height_offset_high_m * 1e3 << "]: within "
+            << reach * 1e3 << " mm of its extent along the grip axis its sides span"
             << " z = " << sides.str() << " mm about its centre, the gel pads +-" << pad * 1e3
             << " mm (with " << kMinPadOverlap * 1e3 << " mm of overlap)";
     throw Error(message.str());
@@ -242,14 +242,7 @@ void GripperSim::buildWorld(double object_height_m) {
 
   // Gels: the package's compliant contact with the material's friction (Bullet multiplies the
   // two bodies' coefficients; the object's is 1).
-  GelPadOptions pads;
-  pads.width_m = config_.gel_width_m;
-  pads.height_m = config_.gel_height_m;
-  pads.thickness_m = config_.gel_thickness_m;
-  pads.friction = config_.object.friction;
-  pads.damping = p.gel_damping;
-  pads.law = config_.gel_law;
-  pads.object_min_half_size_m = objectMinHalfSizeM();
+  const GelPadOptions pads = gelPadOptionsOf(config_, objectMinHalfSizeM());
   world_->gels = std::make_unique<GelPadContacts>(w, world_->dispatcher, 2, pads, kGelGroup);
 
   // Object: dynamic, its body at its bounds' centre.
@@ -286,9 +279,8 @@ void GripperSim::moveFingers(double dt) {
   const double force = std::max(contacts_[0].normal_force_n, contacts_[1].normal_force_n);
   if (next < drive_position_m_ && force >= config_.gripper.max_force_n) next = drive_position_m_;
   drive_position_m_ = next;
-  finger_position_m_ = config_.gripper.stiffness_n_per_m > 0.0
-                           ? compliantFingerPosition(max_move)
-                           : drive_position_m_;
+  finger_position_m_ = config_.gripper.stiffness_n_per_m > 0.0 ? compliantFingerPosition(max_move)
+                                                               : drive_position_m_;
   for (int i = 0; i < 2; ++i) world_->gels->place(i, gelInWorld(static_cast<Finger>(i)));
 }
 
@@ -375,8 +367,8 @@ double GripperSim::closeOnTheObject(double offset_m) {
   // plus what each gel is already indented.
   const double depth =
       e.grasp_force_n > 0.0 ? config_.gel_law.indentation(e.grasp_force_n) : e.grasp_indentation_m;
-  const double width = 2.0 * finger_position_m_ + contacts_[0].penetration_m +
-                       contacts_[1].penetration_m;
+  const double width =
+      2.0 * finger_position_m_ + contacts_[0].penetration_m + contacts_[1].penetration_m;
   // A compliant drive must go further by the deflection the grip's force causes.
   command_ = openingForGap(width - 2.0 * (depth + drivePreload(depth)));
   step(ticksToArrive());
@@ -387,8 +379,7 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
   const EpisodeOptions& e = config_.episode;
   std::mt19937_64 rng(seed);
   const auto [low, high] = height_offset_range_;
-  const double offset =
-      height_offset_m ? *height_offset_m : low + uniform01(rng) * (high - low);
+  const double offset = height_offset_m ? *height_offset_m : low + uniform01(rng) * (high - low);
   // Outside the scene's range the grasp is not the scene's (too high: the object barely touches
   // the gels; below: it tumbles), so a given offset is refused rather than clamped.
   if (!(offset >= e.height_offset_low_m && offset <= e.height_offset_high_m)) {

@@ -310,20 +310,14 @@ void HandSim::buildWorld() {
   }
 
   // Gels: the package's compliant contact, added before the object as GripperSim's.
-  GelPadOptions pads;
-  pads.width_m = config_.gel_width_m;
-  pads.height_m = config_.gel_height_m;
-  pads.thickness_m = config_.gel_thickness_m;
-  pads.friction = config_.object.friction;
-  pads.damping = p.gel_damping;
-  pads.law = config_.gel_law;
-  pads.object_min_half_size_m = static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0;
+  GelPadOptions pads =
+      gelPadOptionsOf(config_, static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0);
   // A hand's gel can have the object behind it (behind its finger, across the palm), where
   // GripperSim's two facing gels never do: a part reaching further behind the gel's surface
   // than twice its thickness is on the sensor's other side, not pressed into its gel.
   pads.behind_gel_m = 2.0 * config_.gel_thickness_m;
-  w.gels = std::make_unique<GelPadContacts>(w.world, w.dispatcher,
-                                            static_cast<int>(sensor_links_.size()), pads, kGelGroup);
+  w.gels = std::make_unique<GelPadContacts>(
+      w.world, w.dispatcher, static_cast<int>(sensor_links_.size()), pads, kGelGroup);
 
   // Object: dynamic, its body at its bounds' centre. The hull's hollows are measured against
   // the first gel's normal at the start.
@@ -627,14 +621,13 @@ void HandSim::measureContacts(double dt) {
   std::fill(contact_stiffness_.begin(), contact_stiffness_.end(), 0.0);
   // Each gel contact point loads the joints that carry its link: the gel is pushed back into
   // itself and dragged by friction.
-  world_->gels->measure(dt, objectInWorld(), contacts_,
-                        [&](int s, const Eigen::Vector3d& on_gel, double normal_n,
-                            const Eigen::Vector3d& friction_n) {
-                          const Eigen::Vector3d out_of_gel =
-                              world_->gels->gelInWorld(s).linear().col(2);
-                          addLoad(sensor_links_[s], on_gel, -out_of_gel * normal_n + friction_n,
-                                  out_of_gel, 0.0);
-                        });
+  world_->gels->measure(
+      dt, objectInWorld(), contacts_,
+      [&](int s, const Eigen::Vector3d& on_gel, double normal_n,
+          const Eigen::Vector3d& friction_n) {
+        const Eigen::Vector3d out_of_gel = world_->gels->gelInWorld(s).linear().col(2);
+        addLoad(sensor_links_[s], on_gel, -out_of_gel * normal_n + friction_n, out_of_gel, 0.0);
+      });
   // The gel's stiffness as the drive sees it, at the patch's centre: the law's tangent.
   for (size_t s = 0; s < contacts_.size(); ++s) {
     const double depth = contacts_[s].penetration_m;
