@@ -383,11 +383,15 @@ bool HandSimRos::onStep(HandStep::Request& request, HandStep::Response& response
 }
 
 void HandSimRos::onTick(const ros::WallTime& scheduled) {
-  // One frame a tick; a tick that ran late is not made up (the frames it missed are skipped).
+  // One frame a tick, stamped with the tick's time on the grid (wall clock): the stamps say when
+  // the frame was due, whatever the start-up took, so a subscriber's latency is its own. A tick
+  // that ran late is not made up: the frames it missed are skipped (their stamps with them).
   {
     std::lock_guard<std::mutex> lock(mutex_);
     sim_->step(ticks_per_frame_);
     ++frame_;
+    time_base_ = ros::Time(scheduled.sec, scheduled.nsec) -
+                 (ros_conversions::toRosTime(frame_ * frame_period_ns_) - ros::Time(0));
     publishFrame();
   }
   if ((ros::WallTime::now() - scheduled).toNSec() > 4 * frame_period_ns_) {

@@ -6,6 +6,9 @@
 //                                             the same policy loop against a running
 //                                             hand_sim.launch, every sensor of its hand
 //                                             delivered (frames/s and images/s)
+//   norm2tex_ros_bench hand_real_time [FRAMES]
+//                                             every sensor of a real-time hand_sim.launch:
+//                                             frames missed and stamp-to-image latency
 //   norm2tex_ros_bench real_time [FRAMES] [split]
 //                                             latency from a frame's stamp to its images'
 //                                             arrival here (wall-clock stamps), p50 / p99 / max;
@@ -39,10 +42,10 @@ namespace {
 using norm2tex::waitFor;
 
 struct Arrivals {
-  std::map<ros::Time, int> count;            // images per stamp (both sensors)
-  std::map<ros::Time, ros::WallTime> first;  // when the stamp's first image arrived
-  std::map<ros::Time, ros::WallTime> last;   // when the stamp's last image arrived
-  std::map<ros::Time, ros::WallTime> frame;  // when its SimFrame arrived (physics done)
+  std::map<ros::Time, int> count;               // images per stamp (both sensors)
+  std::map<ros::Time, ros::WallTime> first;     // when the stamp's first image arrived
+  std::map<ros::Time, ros::WallTime> last;      // when the stamp's last image arrived
+  std::map<ros::Time, ros::WallTime> frame;     // when its SimFrame arrived (physics done)
   std::map<ros::Time, std::string> first_from;  // the gel frame of the stamp's first image
   int total = 0;
 };
@@ -82,24 +85,87 @@ int benchHandSynchronous(ros::NodeHandle& nh, int frames) {
   waitFor([&] { return count[srv.response.stamp] == sensors.size(); }, 10);
   const ros::WallTime start = ros::WallTime::now();
   for (int i = 0; i < frames; ++i) {
-    if (!step.call(srv) || !srv.response.success) return fail(("~step failed: " + srv.response.message).c_str());
+    if (!step.call(srv) || !srv.response.success)
+      return fail(("~step failed: " + srv.response.message).c_str());
     const ros::Time stamp = srv.response.stamp;
     if (!waitFor([&] { return count[stamp] == sensors.size(); }, 10)) {
       return fail("a step's images did not all arrive within 10 s");
     }
   }
   const double loop = (ros::WallTime::now() - start).toSec();
-  std::printf("hand_synchronous, %d frames, %zu sensors delivered: policy loop (step 1 + wait) "
-              "%.0f frames/s (%.2f ms/frame), %.0f images/s\n",
-              frames, sensors.size(), frames / loop, 1e3 * loop / frames,
-              frames * sensors.size() / loop);
+  std::printf(
+      "hand_synchronous, %d frames, %zu sensors delivered: policy loop (step 1 + wait) "
+      "%.0f frames/s (%.2f ms/frame), %.0f images/s\n",
+      frames, sensors.size(), frames / loop, 1e3 * loop / frames, frames * sensors.size() / loop);
   return 0;
+}
+
+/// hand_real_time: every sensor of a hand_sim.launch running in real time, over FRAMES frames
+/// of the clock: the frames each sensor missed (gaps in its stamps, which sit on the frame grid),
+/// and the latency from a frame's stamp (wall clock) to its image's arrival here.
+int benchHandRealTime(ros::NodeHandle& nh, int frames) {
+  std::vector<std::string> sensors;
+  if (!waitFor([&] { return nh.getParam("hand_sim/sensors", sensors); }, 60, 0.05)) {
+    return fail("no hand_sim/sensors parameter within 60 s (is hand_sim.launch running?)");
+  }
+  double rate = 60.0;
+  nh.getParam("hand_sim/frame_rate", rate);
+  std::map<std::string, std::vector<ros::Time>> stamps;
+  std::vector<double> latency_ms;
+  latency_ms.reserve(static_cast<size_t>(frames) * sensors.size() + 1000);
+  std::vector<ros::Subscriber> subs;
+  for (const std::string& sensor : sensors) {
+    subs.push_back(nh.subscribe<sensor_msgs::Image>(
+        sensor + "/image_raw", 2 * frames + 200,
+        [&, sensor](const sensor_msgs::Image::ConstPtr& m) {
+          stamps[sensor].push_back(m->header.stamp);
+          const ros::WallTime now = ros::WallTime::now();
+          latency_ms.push_back(1e3 * (now.toSec() - m->header.stamp.toSec()));
+        },
+        {}, ros::TransportHints().tcpNoDelay()));
+  }
+  const auto all_have = [&](size_t n) {
+    for (const std::string& sensor : sensors) {
+      if (stamps[sensor].size() < n) return false;
+    }
+    return true;
+  };
+  // Counted from when every sensor publishes (the renderers' first frames wait for textures).
+  if (!waitFor([&] { return all_have(1); }, 120))
+    return fail("not every sensor published within 120 s");
+  // (Callbacks run only inside waitFor: nothing arrives while this starts the count.)
+  const size_t skip = latency_ms.size();
+  for (auto& [sensor, s] : stamps) s.clear();
+  const double seconds = frames / rate;
+  if (!waitFor([&] { return all_have(static_cast<size_t>(frames)); }, 2.0 * seconds + 30.0)) {
+    return fail("the sensors did not publish FRAMES images within twice their time");
+  }
+  const double period = 1.0 / rate;
+  int lost = 0;
+  for (const std::string& sensor : sensors) {
+    const std::vector<ros::Time>& s = stamps[sensor];
+    int missing = 0;
+    for (size_t i = 1; i < static_cast<size_t>(frames); ++i) {
+      missing += static_cast<int>(std::lround((s[i] - s[i - 1]).toSec() / period)) - 1;
+    }
+    lost += missing;
+    std::printf("  %s: %d images over %.1f s of frames, %d frames missed\n", sensor.c_str(), frames,
+                (s[frames - 1] - s[0]).toSec(), missing);
+  }
+  std::vector<double> measured(latency_ms.begin() + static_cast<long>(skip), latency_ms.end());
+  std::printf(
+      "hand_real_time, %d frames at %.0f Hz, %zu sensors: %d frames missed in all; "
+      "latency stamp -> image p50 %.2f ms, p99 %.2f ms, max %.2f ms\n",
+      frames, rate, sensors.size(), lost, percentile(measured, 0.5), percentile(measured, 0.99),
+      *std::max_element(measured.begin(), measured.end()));
+  return lost == 0 ? 0 : 1;
 }
 
 int main(int argc, char** argv) {
   const char* const usage =
       "usage: norm2tex_ros_bench synchronous [FRAMES >= 10]\n"
       "       norm2tex_ros_bench hand_synchronous [FRAMES >= 10]\n"
+      "       norm2tex_ros_bench hand_real_time [FRAMES >= 10]\n"
       "       norm2tex_ros_bench real_time [FRAMES >= 10] [split] [--arrivals FILE]\n";
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
@@ -125,7 +191,8 @@ int main(int argc, char** argv) {
   // A malformed FRAMES counts as too few: the usage, not an uncaught exception.
   const int frames = args.size() > 1 ? std::atoi(args[1].c_str()) : 600;
   const bool split = args.size() > 2 && args[2] == "split";
-  const bool bad_mode = mode != "synchronous" && mode != "real_time" && mode != "hand_synchronous";
+  const bool bad_mode = mode != "synchronous" && mode != "real_time" &&
+                        mode != "hand_synchronous" && mode != "hand_real_time";
   if (bad_mode || frames < 10 || (args.size() > 2 && !split) || args.size() > 3 || bad ||
       (!arrivals_file.empty() && mode != "real_time")) {
     std::fputs(usage, stderr);
@@ -133,6 +200,7 @@ int main(int argc, char** argv) {
   }
   ros::NodeHandle nh;
   if (mode == "hand_synchronous") return benchHandSynchronous(nh, frames);
+  if (mode == "hand_real_time") return benchHandRealTime(nh, frames);
   Arrivals arrivals;
   auto on_image = [&](const sensor_msgs::Image::ConstPtr& m) {
     ++arrivals.total;
@@ -177,7 +245,8 @@ int main(int argc, char** argv) {
     // The policy loop: step one frame, wait for both of its images.
     ros::WallTime start = ros::WallTime::now();
     for (int i = 0; i < frames; ++i) {
-      if (!step.call(srv) || !srv.response.success) return fail(("~step failed: " + srv.response.message).c_str());
+      if (!step.call(srv) || !srv.response.success)
+        return fail(("~step failed: " + srv.response.message).c_str());
       const ros::Time stamp = srv.response.stamp;
       if (!waitFor([&] { return arrivals.count[stamp] == 2; }, 10))
         return fail("a step's two images did not arrive within 10 s");
