@@ -176,5 +176,37 @@ TEST(TactileHand, TheAllegroRendersOneImagePerDigit) {
   EXPECT_GT((hand.objectInGel(0).translation() - hand.objectInGel(1).translation()).norm(), 0.01);
 }
 
+TEST(TactileHand, SensorsRenderedAtOnceGiveTheFramesRenderedOneAfterAnother) {
+  // The Allegro palm up, four fingers closed on a ball, wood texture and noise: every sensor's
+  // frame the same on one thread and on one per sensor.
+  HandSimConfig config;
+  config.hand = loadHandConfig(kRobots + "/allegro_hand_description/allegro_palm_up.yaml");
+  config.object.mesh = "sphere:45";
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.03, 0.0, 0.17));
+  const SensorModel sensor = makeDigitSensorModel();
+  TactileHandOptions options;
+  options.material_config = std::string(NORM2TEX_SOURCE_DIR) + "/config/materials/wood.yaml";
+  options.noise_seed = 5;
+  TactileHand serial(config, sensor, options);
+  options.render_threads = 4;
+  TactileHand parallel(config, sensor, options);
+  const std::vector<std::string> fingers = {"joint_1.0", "joint_5.0", "joint_9.0", "joint_13.0"};
+  const std::vector<double> closed = {0.9, 0.9, 0.9, 1.2};
+  int touching = 0;
+  for (TactileHand* hand : {&serial, &parallel}) {
+    hand->sim().setJointTargets(fingers, closed);
+    hand->step(60);
+  }
+  for (int s = 0; s < 4; ++s) {
+    EXPECT_TRUE(sameImage(serial.frame(s).image, parallel.frame(s).image)) << s;
+    touching += !sameImage(serial.frame(s).image, serial.background(s));
+  }
+  EXPECT_GE(touching, 1);  // a test of rendered contacts, not of blank frames
+
+  options.render_threads = -1;
+  test::expectError([&] { TactileHand bad(config, sensor, options); },
+                    {"render_threads = -1", "[0, 256]"});
+}
+
 }  // namespace
 }  // namespace norm2tex

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "norm2tex/common/parallel_for.hpp"
 #include "norm2tex/render/object_texture_cache.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
@@ -33,6 +34,10 @@ struct TactileHandOptions {
   /// Count f from each reset's first frame instead of from construction (an episode's images
   /// then depend only on its seeds and commands).
   bool noise_per_episode = false;
+  /// Threads the sensors render on, the caller's included (each sensor's frame is the same
+  /// whatever the count): 1 renders them one after another (for hands already run in parallel,
+  /// as a batch does); 0: one per core, at most one per sensor.
+  int render_threads = 1;
 };
 
 /// Throws Error naming the first option out of range and its valid range.
@@ -43,7 +48,8 @@ void validate(const TactileHandOptions& options);
 /// thread, for learning and scripting without ROS. Modelled on TactileGripper: physics at whole
 /// ticks per frame (rate_hz = ticks x frame_rate), resets padded to whole frames, frame index
 /// = ticks / ticks per frame, the renderers' per-frame noise seed. The sensors render one after
-/// another.
+/// another, or on options.render_threads threads at once (hand_sim.launch renders them in
+/// parallel too: a nodelet each).
 ///
 /// Not thread-safe; distinct hands may run on distinct threads.
 class TactileHand {
@@ -122,6 +128,7 @@ class TactileHand {
   std::int64_t episode_first_frame_ = 0;
   double beta_mm_ = 0.0;
   int variant_ = 0;
+  std::unique_ptr<ParallelFor> render_pool_;  ///< null: the sensors render one after another
 };
 
 }  // namespace norm2tex

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <thread>
 
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
@@ -20,6 +21,10 @@ constexpr std::size_t kKeptVariants = 32;
 
 void validate(const TactileHandOptions& o) {
   detail::validateTactileOptions(o, "tactile hand option");
+  if (o.render_threads < 0 || o.render_threads > 256) {
+    throw Error("tactile hand option render_threads = " + std::to_string(o.render_threads) +
+                " is out of range; valid: [0, 256] (0: one per core)");
+  }
 }
 
 TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
@@ -29,7 +34,8 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
   validate(options_);
   validate(sensor);
   // As TactileGripper: the material's friction and beta unless given.
-  const detail::TactileSetup setup = detail::resolveTactileOptions(options_, kDefaultTactileFriction);
+  const detail::TactileSetup setup =
+      detail::resolveTactileOptions(options_, kDefaultTactileFriction);
   config.object.friction = setup.friction;
   if (setup.material) config.object.material = setup.material->name;
   config.gel_width_m = sensor.gel_pad_width_mm * 1e-3;
@@ -46,6 +52,10 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
                                      : std::make_unique<TactileRenderer>(loadSensorModel(own)));
   }
   frames_.assign(renderers_.size(), nullptr);
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads =
+      std::min(sensorCount(), options_.render_threads == 0 ? cores : options_.render_threads);
+  if (threads > 1) render_pool_ = std::make_unique<ParallelFor>(threads);
 
   beta_mm_ = setup.beta_mm;
   if (beta_mm_ > 0.0) {
@@ -102,7 +112,12 @@ void TactileHand::render(int sensor) {
 }
 
 void TactileHand::renderAll() {
-  for (int s = 0; s < sensorCount(); ++s) render(s);
+  // Each sensor has a renderer of its own and reads the physics only: they may run at once.
+  if (render_pool_) {
+    render_pool_->run(sensorCount(), [this](int s) { render(s); });
+  } else {
+    for (int s = 0; s < sensorCount(); ++s) render(s);
+  }
 }
 
 Eigen::Isometry3d TactileHand::objectInGel(int sensor) const {
