@@ -10,7 +10,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/sim/tactile_gripper.hpp"
 #include "norm2tex/sim/tactile_gripper_batch.hpp"

@@ -17,7 +17,7 @@
 #include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/probe_scenario.hpp"
 #include "norm2tex/sim/probe_schedule.hpp"
 

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "norm2tex/render/sensor_model.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 #include "test_helpers.hpp"
 

@@ -16,7 +16,7 @@
 #include "norm2tex/render/contact_rasterizer.hpp"
 #include "norm2tex/render/gel_conformity.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

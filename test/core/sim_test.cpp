@@ -9,7 +9,7 @@
 #include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/contact_patch.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 #include "test_helpers.hpp"
 

@@ -20,7 +20,7 @@
 #include "norm2tex/common/image_io.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {

@@ -18,7 +18,7 @@
 #include "norm2tex/render/digit_shader.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 
 namespace {
 using norm2tex::test::CliRun;

@@ -16,7 +16,7 @@
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/render/texture_overlay.hpp"
 #include "norm2tex/mesh/textured_mesh.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 
 namespace norm2tex {
 

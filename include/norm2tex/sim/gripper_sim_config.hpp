@@ -4,7 +4,7 @@
 #include <string>
 
 #include "norm2tex/render/sensor_model.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 
 namespace norm2tex {
 

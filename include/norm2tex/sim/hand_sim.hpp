@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "norm2tex/mesh/object_mesh.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/sim/hand_config.hpp"
 #include "norm2tex/sim/hand_description.hpp"

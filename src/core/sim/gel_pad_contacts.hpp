@@ -12,7 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "norm2tex/sim/gel_contact.hpp"
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 
 namespace norm2tex {

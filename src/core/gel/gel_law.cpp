@@ -1,4 +1,4 @@
-#include "norm2tex/sim/gel_law.hpp"
+#include "norm2tex/gel/gel_law.hpp"
 
 #include <cmath>
 #include <sstream>
