@@ -4,35 +4,54 @@
 
 #include <chrono>
 #include <cstdio>
-#include <iostream>
+#include <string>
+#include <vector>
 
 #include "cli_arguments.hpp"
 #include "dataset_export.hpp"
 
 namespace {
 
-const char* const kUsage =
-    "usage: norm2tex_export BAG [BAG ...] -o DIR [--force] [--depth png16|tiff]\n"
-    "                       [--background SENSOR=FILE.png ...]\n"
-    "  Writes DIR/raw/<material>/*.png, DIR/diff/<material>/*.png (image - background + 128),\n"
-    "  DIR/depth/<material>/*.png (uint16 micrometres; --depth tiff: float32 metres),\n"
-    "  DIR/labels.csv and DIR/export.yaml. The bags of one recording (split parts, shards) are\n"
-    "  read in the order given. DIR must be empty unless --force.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::UsageError;
 
-int run(int argc, char** argv) {
-  using norm2tex::cli::UsageError;
-  const norm2tex::cli::Arguments args(argc, argv, {"-o", "--out", "--depth", "--background"},
-                                      {"--force"});
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_export",
+      "norm2tex_export BAG [BAG ...] -o DIR [--force] [--depth png16|tiff]\n"
+      "                       [--background SENSOR=FILE.png ...]",
+      "Exports dataset_recorder bags for training: DIR/raw/<material>/*.png,\n"
+      "DIR/diff/<material>/*.png (image - background + 128), DIR/depth/<material>/*.png\n"
+      "(uint16 micrometres; --depth tiff: float32 metres), DIR/labels.csv and DIR/export.yaml.\n"
+      "The bags of one recording (split parts, shards) are read in the order given.");
+  program.positional("BAG", -1, po::value<std::vector<std::string>>());
+  program.add()  //
+      ("output,out,o", po::value<std::string>()->value_name("DIR"),
+       "The output directory (also --out); it must be empty unless --force.")  //
+      ("force", po::bool_switch(), "Write into a DIR that is not empty.")      //
+      ("depth", po::value<std::string>()->value_name("png16|tiff"),
+       "The depth images' format (default png16).")  //
+      ("background",
+       po::value<std::vector<std::string>>()->composing()->value_name("SENSOR=FILE.png"),
+       "A sensor's background for the diff images when the bags hold none (the renderer's "
+       "latched SENSOR/background), repeatable.");
+  return program;
+}
+
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  const po::variables_map args = program.parse(argc, argv);
   norm2tex::ExportOptions options;
-  options.out_dir = args.value("-o", args.value("--out", ""));
+  options.out_dir = norm2tex::cli::valueOr<std::string>(args, "output", "");
   if (options.out_dir.empty()) throw UsageError("no output directory (-o DIR)");
-  if (args.positional().empty()) throw UsageError("no bag given");
-  options.force = args.flag("--force");
-  options.depth_format = args.value("--depth", "png16");
+  if (!args.count("BAG")) throw UsageError("no bag given");
+  const std::vector<std::string> bags = args["BAG"].as<std::vector<std::string>>();
+  options.force = args["force"].as<bool>();
+  options.depth_format = norm2tex::cli::valueOr<std::string>(args, "depth", "png16");
   if (options.depth_format != "png16" && options.depth_format != "tiff") {
     throw UsageError("--depth " + options.depth_format + " is not valid; valid: png16, tiff");
   }
-  for (const std::string& spec : args.values("--background")) {
+  for (const std::string& spec :
+       norm2tex::cli::valueOr(args, "background", std::vector<std::string>())) {
     const std::size_t eq = spec.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size()) {
       throw UsageError("--background " + spec + " is not valid; valid: SENSOR=FILE.png");
@@ -48,12 +67,13 @@ int run(int argc, char** argv) {
   // each report is a line of its own, not one enormous line of carriage returns.
   const bool terminal = isatty(fileno(stderr)) != 0;
   const norm2tex::ExportSummary summary =
-      norm2tex::exportDataset(args.positional(), options, [&](std::uint64_t done) {
+      norm2tex::exportDataset(bags, options, [&](std::uint64_t done) {
         const double now = seconds();
         if (now - last_report < 0.5) return;  // a progress line at most twice a second
         last_report = now;
-        std::fprintf(stderr, terminal ? "\rnorm2tex_export: %lu frames (%.0f/s)"
-                                      : "norm2tex_export: %lu frames (%.0f/s)\n",
+        std::fprintf(stderr,
+                     terminal ? "\rnorm2tex_export: %lu frames (%.0f/s)"
+                              : "norm2tex_export: %lu frames (%.0f/s)\n",
                      static_cast<unsigned long>(done), done / std::max(now, 1e-9));
       });
   if (last_report >= 0.0 && terminal) std::fprintf(stderr, "\n");
@@ -70,5 +90,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_export", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

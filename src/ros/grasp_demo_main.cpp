@@ -1,13 +1,12 @@
 // norm2tex_grasp_demo: drives a synchronous gripper_sim.launch through the paper's grasp
 // (grasp, squeeze, open slowly until the cube drops) and saves both DIGITs' images at several
 // moments, plus a labelled strip of them. The main job runs it headless.
-//
-//   norm2tex_grasp_demo OUT_DIR [--seed S] [--height-offset M]
+// Its options: norm2tex_grasp_demo --help.
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -18,6 +17,7 @@
 #include <sensor_msgs/image_encodings.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "cli_arguments.hpp"
 #include "contact_sheet.hpp"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
@@ -26,6 +26,7 @@
 
 namespace {
 
+namespace po = norm2tex::cli::po;
 using norm2tex::waitFor;
 
 const char* const kSensors[2] = {"digit_left", "digit_right"};
@@ -39,52 +40,37 @@ cv::Mat3b toMat(const sensor_msgs::Image& msg) {
   return cv_bridge::toCvCopy(msg, sensor_msgs::image_encodings::BGR8)->image;
 }
 
-}  // namespace
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_grasp_demo", "norm2tex_grasp_demo OUT_DIR [--seed S] [--height-offset M]",
+      "Runs the paper's grasp on a synchronous gripper_sim.launch (started separately): grasp,\n"
+      "squeeze, open slowly until the cube drops. It saves both DIGITs' images at several\n"
+      "moments, and a labelled strip of them, in OUT_DIR. It exits 0 when the cube dropped.");
+  program.positional("OUT_DIR", 1, po::value<std::string>());
+  program.add()  //
+      ("seed", po::value<std::int64_t>()->value_name("S"),
+       "The episode's seed, >= 0 (default 1).")  //
+      ("height-offset", po::value<double>()->value_name("M"),
+       "Metres, the object's centre above the gels' centres, within the scene's range (default "
+       "0.008).");
+  return program;
+}
 
-int main(int argc, char** argv) {
-  const char* const usage =
-      "usage: norm2tex_grasp_demo OUT_DIR [--seed S] [--height-offset M]\n"
-      "  Runs the grasp on a synchronous gripper_sim.launch (started separately) and saves both\n"
-      "  DIGITs' images at several moments, and a labelled strip of them, in OUT_DIR.\n";
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
-      std::fputs(usage, stdout);
-      return 0;
-    }
-  }
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  // ros::init first: it takes its own arguments (name:=value remappings) off the command line.
   ros::init(argc, argv, "norm2tex_grasp_demo", ros::init_options::AnonymousName);
-  if (argc < 2 || argc % 2 != 0) {
-    std::fputs(usage, stderr);
-    return 2;
+  const po::variables_map args = program.parse(argc, argv);
+  if (!args.count("OUT_DIR")) throw norm2tex::cli::UsageError("missing OUT_DIR");
+  const std::filesystem::path out = args["OUT_DIR"].as<std::string>();
+  const std::int64_t seed = norm2tex::cli::valueOr<std::int64_t>(args, "seed", 1);
+  if (seed < 0) {
+    throw norm2tex::cli::UsageError("--seed must be >= 0, got " + std::to_string(seed));
   }
-  const std::filesystem::path out = argv[1];
-  std::int64_t seed = 1;
-  double height_offset = 0.008;
-  for (int i = 2; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    try {
-      size_t used = 0;
-      if (flag == "--seed") {
-        seed = std::stoll(argv[i + 1], &used);
-      } else if (flag == "--height-offset") {
-        height_offset = std::stod(argv[i + 1], &used);
-      } else {
-        std::fprintf(stderr, "norm2tex_grasp_demo: unknown option %s\n%s", flag.c_str(), usage);
-        return 2;
-      }
-      if (argv[i + 1][used] != '\0') throw std::invalid_argument("trailing characters");
-    } catch (const std::exception&) {
-      std::fprintf(stderr, "norm2tex_grasp_demo: %s %s is not a number\n%s", flag.c_str(),
-                   argv[i + 1], usage);
-      return 2;
-    }
-  }
+  const double height_offset = norm2tex::cli::valueOr(args, "height-offset", 0.008);
   std::error_code error;
   std::filesystem::create_directories(out, error);
   if (error) {
-    std::fprintf(stderr, "norm2tex_grasp_demo: cannot create %s: %s\n", out.c_str(),
-                 error.message().c_str());
-    return 1;
+    throw std::runtime_error("cannot create " + out.string() + ": " + error.message());
   }
 
   // The launch that starts the master may still be coming up: wait for it quietly (a node handle
@@ -92,9 +78,7 @@ int main(int argc, char** argv) {
   const ros::WallTime master_deadline = ros::WallTime::now() + ros::WallDuration(30.0);
   while (!ros::master::check()) {
     if (ros::WallTime::now() > master_deadline) {
-      std::fprintf(stderr, "norm2tex_grasp_demo: no ROS master at %s within 30 s\n",
-                   ros::master::getURI().c_str());
-      return 1;
+      throw std::runtime_error("no ROS master at " + ros::master::getURI() + " within 30 s");
     }
     ros::WallDuration(0.1).sleep();
   }
@@ -111,8 +95,7 @@ int main(int argc, char** argv) {
   ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("contact_sim/step");
   ros::ServiceClient reset = nh.serviceClient<norm2tex::Reset>("contact_sim/reset");
   if (!step.waitForExistence(ros::Duration(60.0)) || !reset.waitForExistence(ros::Duration(5.0))) {
-    std::fprintf(stderr, "norm2tex_grasp_demo: no synchronous contact_sim (~step) within 60 s\n");
-    return 1;
+    throw std::runtime_error("no synchronous contact_sim (~step) within 60 s");
   }
   if (!waitFor(
           [&] {
@@ -122,17 +105,14 @@ int main(int argc, char** argv) {
             return true;
           },
           30.0)) {
-    std::fprintf(stderr, "norm2tex_grasp_demo: the renderers' topics never connected\n");
-    return 1;
+    throw std::runtime_error("the renderers' topics never connected");
   }
 
   norm2tex::Reset episode;
   episode.request.seed = seed;
   episode.request.height_offset = height_offset;
   if (!reset.call(episode) || !episode.response.success) {
-    std::fprintf(stderr, "norm2tex_grasp_demo: ~reset failed: %s\n",
-                 episode.response.message.c_str());
-    return 1;
+    throw std::runtime_error("~reset failed: " + episode.response.message);
   }
 
   // One frame per call: the call returns once both images of it are published, so waiting
@@ -175,32 +155,34 @@ int main(int argc, char** argv) {
                 moment.c_str());
   };
 
-  try {
-    advance(0.0);
-    save("grasp");
-    for (int i = 0; i < 10; ++i) advance(-0.005);  // squeeze: 2 mm narrower
-    for (int i = 0; i < 20; ++i) advance(0.0);     // let the fingers get there
-    save("squeeze");
-    int frames = 0;
-    bool saved_release = false;
-    while (!srv.response.dropped && frames < 600) {
-      advance(srv.response.opening < 0.98 ? 0.0025 : 0.0);
-      ++frames;
-      const auto& contact = latest.contacts[kSensors[0]];
-      if (!saved_release && contact && contact->normal_force < 2.0) {
-        save("release");
-        saved_release = true;
-      }
+  advance(0.0);
+  save("grasp");
+  for (int i = 0; i < 10; ++i) advance(-0.005);  // squeeze: 2 mm narrower
+  for (int i = 0; i < 20; ++i) advance(0.0);     // let the fingers get there
+  save("squeeze");
+  int frames = 0;
+  bool saved_release = false;
+  while (!srv.response.dropped && frames < 600) {
+    advance(srv.response.opening < 0.98 ? 0.0025 : 0.0);
+    ++frames;
+    const auto& contact = latest.contacts[kSensors[0]];
+    if (!saved_release && contact && contact->normal_force < 2.0) {
+      save("release");
+      saved_release = true;
     }
-    for (int i = 0; i < 10; ++i) advance(0.0);
-    save(srv.response.dropped ? "dropped" : "open");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "norm2tex_grasp_demo: %s\n", e.what());
-    return 1;
   }
+  for (int i = 0; i < 10; ++i) advance(0.0);
+  save(srv.response.dropped ? "dropped" : "open");
   const std::string strip = (out / "grasp_sequence.png").string();
   cv::imwrite(strip, norm2tex::cli::makeContactSheet(tiles, {"digit_left", "digit_right"}, labels));
   std::printf("grasp sequence (both sensors) -> %s; the object %s\n", strip.c_str(),
               srv.response.dropped ? "dropped" : "did not drop");
   return srv.response.dropped ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

@@ -14,14 +14,14 @@
 // loaded by a client; names are resolved in the group's namespace. An entry's optional
 // `params: {key: value, ...}` are set in that namespace before the nodelet is loaded.
 // ~num_worker_threads as for `nodelet manager`.
-#include <cstdio>
-#include <cstring>
 #include <string>
 #include <vector>
 
 #include <nodelet/loader.h>
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpcValue.h>
+
+#include "cli_arguments.hpp"
 
 namespace {
 
@@ -63,22 +63,23 @@ std::vector<NodeletSpec> readNodelets(const ros::NodeHandle& pnh, std::string* w
   return specs;
 }
 
-}  // namespace
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "nodelet_group", "rosrun norm2tex nodelet_group [__name:=NAME]  (usually from a launch file)",
+      "A nodelet manager that loads the nodelets of its ~nodelets parameter itself, instead of\n"
+      "one `nodelet load` client process per nodelet. Its load_nodelet and unload_nodelet\n"
+      "services stay up, as a `nodelet manager`'s do.");
+  program.notes(
+      "parameters:\n"
+      "  ~nodelets: [{name: NAME, type: PACKAGE/Type[, params: {KEY: VALUE, ...}]}, ...]\n"
+      "      (params: set in the nodelet's private namespace first)\n"
+      "  ~num_worker_threads: as for `nodelet manager`");
+  return program;
+}
 
-int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
-      std::fputs(
-          "usage: rosrun norm2tex nodelet_group [__name:=NAME]  (usually from a launch file)\n"
-          "  A nodelet manager that loads the nodelets of its ~nodelets parameter itself:\n"
-          "  ~nodelets: [{name: NAME, type: PACKAGE/Type[, params: {KEY: VALUE, ...}]}, ...]\n"
-          "  (params: set in the nodelet's private namespace first); ~num_worker_threads as for\n"
-          "  `nodelet manager`.\n",
-          stdout);
-      return 0;
-    }
-  }
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   ros::init(argc, argv, "nodelet_group");
+  program.parse(argc, argv);  // no arguments of its own beyond ROS's name:=value remappings
   ros::NodeHandle pnh("~");
   std::string why;
   const std::vector<NodeletSpec> specs = readNodelets(pnh, &why);
@@ -107,4 +108,11 @@ int main(int argc, char** argv) {
   ros::spin();
   // The loader's destructor unloads the nodelets (a recorder closes its bag) before exit.
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

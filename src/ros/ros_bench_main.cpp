@@ -21,8 +21,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <string>
@@ -32,6 +30,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
+#include "cli_arguments.hpp"
 #include "norm2tex/HandStep.h"
 #include "norm2tex/SimFrame.h"
 #include "norm2tex/Step.h"
@@ -39,7 +38,9 @@
 
 namespace {
 
+namespace po = norm2tex::cli::po;
 using norm2tex::waitFor;
+using norm2tex::cli::UsageError;
 
 struct Arrivals {
   std::map<ros::Time, int> count;               // images per stamp (both sensors)
@@ -51,13 +52,39 @@ struct Arrivals {
 };
 
 int fail(const char* why) {
-  std::fprintf(stderr, "norm2tex_ros_bench: %s\n", why);
+  std::fprintf(stderr, "norm2tex_ros_bench: error: %s\n", why);
   return 1;
 }
 
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
+}
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_ros_bench",
+      "norm2tex_ros_bench synchronous [FRAMES]\n"
+      "       norm2tex_ros_bench hand_synchronous [FRAMES]\n"
+      "       norm2tex_ros_bench hand_real_time [FRAMES]\n"
+      "       norm2tex_ros_bench real_time [FRAMES] [split] [--arrivals FILE]",
+      "Measures the end-to-end speed of a running gripper_sim.launch (hand_sim.launch for\n"
+      "hand_synchronous), every sensor's images delivered to this subscriber. synchronous: the\n"
+      "frames/s of ~step, one call per frame (the policy loop) and one call for all frames.\n"
+      "hand_synchronous: the same policy loop against hand_sim, frames/s and images/s.\n"
+      "hand_real_time: every sensor of a real-time hand_sim.launch, the frames it missed and\n"
+      "the latency from a frame's stamp to its image.\n"
+      "real_time: the latency from a frame's stamp to its images' arrival here (wall-clock\n"
+      "stamps), p50 / p99 / max; with split, also when its physics was done, and the first and\n"
+      "second image. FRAMES: at least 10 (default 600).");
+  program.positional("MODE", 1, po::value<std::string>());
+  program.positional("FRAMES", 1, po::value<int>());
+  program.positional("SPLIT", 1, po::value<std::string>());
+  program.add()  //
+      ("arrivals", po::value<std::string>()->value_name("FILE"),
+       "real_time: also write each frame's image arrivals as CSV "
+       "(stamp_ns,first_ns,second_ns,first_frame_id), for scripts/latency_trace.");
+  return program;
 }
 
 }  // namespace
@@ -161,43 +188,30 @@ int benchHandRealTime(ros::NodeHandle& nh, int frames) {
   return lost == 0 ? 0 : 1;
 }
 
-int main(int argc, char** argv) {
-  const char* const usage =
-      "usage: norm2tex_ros_bench synchronous [FRAMES >= 10]\n"
-      "       norm2tex_ros_bench hand_synchronous [FRAMES >= 10]\n"
-      "       norm2tex_ros_bench hand_real_time [FRAMES >= 10]\n"
-      "       norm2tex_ros_bench real_time [FRAMES >= 10] [split] [--arrivals FILE]\n";
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
-      std::fputs(usage, stdout);
-      return 0;
-    }
-  }
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  // ros::init first: it takes its own arguments (name:=value remappings) off the command line.
   ros::init(argc, argv, "norm2tex_ros_bench", ros::init_options::AnonymousName);
-  // --arrivals FILE may stand anywhere; the rest is positional.
-  std::vector<std::string> args;
-  std::string arrivals_file;
-  bool bad = false;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--arrivals") != 0) {
-      args.emplace_back(argv[i]);
-    } else if (i + 1 < argc) {
-      arrivals_file = argv[++i];
-    } else {
-      bad = true;
-    }
+  const po::variables_map args = program.parse(argc, argv);
+  const std::string mode = norm2tex::cli::valueOr<std::string>(args, "MODE", "");
+  if (mode != "synchronous" && mode != "real_time" && mode != "hand_synchronous" &&
+      mode != "hand_real_time") {
+    throw UsageError(
+        mode.empty() ? "missing MODE (synchronous, hand_synchronous, hand_real_time or real_time)"
+                     : "unknown MODE '" + mode +
+                           "'; valid: synchronous, hand_synchronous, hand_real_time, real_time");
   }
-  const std::string mode = !args.empty() ? args[0] : "";
-  // A malformed FRAMES counts as too few: the usage, not an uncaught exception.
-  const int frames = args.size() > 1 ? std::atoi(args[1].c_str()) : 600;
-  const bool split = args.size() > 2 && args[2] == "split";
-  const bool bad_mode = mode != "synchronous" && mode != "real_time" &&
-                        mode != "hand_synchronous" && mode != "hand_real_time";
-  if (bad_mode || frames < 10 || (args.size() > 2 && !split) || args.size() > 3 || bad ||
-      (!arrivals_file.empty() && mode != "real_time")) {
-    std::fputs(usage, stderr);
-    return 2;
+  const int frames = norm2tex::cli::valueOr(args, "FRAMES", 600);
+  if (frames < 10) throw UsageError("FRAMES must be at least 10, got " + std::to_string(frames));
+  const std::string split_word = norm2tex::cli::valueOr<std::string>(args, "SPLIT", "");
+  if (!split_word.empty() && split_word != "split") {
+    throw UsageError("unexpected argument '" + split_word + "' (only 'split' may follow FRAMES)");
   }
+  const bool split = !split_word.empty();
+  const std::string arrivals_file = norm2tex::cli::valueOr<std::string>(args, "arrivals", "");
+  if ((split || args.count("arrivals")) && mode != "real_time") {
+    throw UsageError(std::string(split ? "split" : "--arrivals") + " is for real_time only");
+  }
+  if (args.count("arrivals") && arrivals_file.empty()) throw UsageError("--arrivals: empty FILE");
   ros::NodeHandle nh;
   if (mode == "hand_synchronous") return benchHandSynchronous(nh, frames);
   if (mode == "hand_real_time") return benchHandRealTime(nh, frames);
@@ -343,4 +357,9 @@ int main(int argc, char** argv) {
       percentile(first_ms, 0.5), percentile(first_ms, 0.99), percentile(second_ms, 0.5),
       percentile(second_ms, 0.99));
   return 0;
+}
+
+int main(int argc, char** argv) {
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

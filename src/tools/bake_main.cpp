@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <iostream>
 #include <limits>
 #include <string>
 
@@ -20,27 +19,72 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: norm2tex_bake NORMAL_MAP -o OUT.(tiff|tif|png) [--mask M] [--convention "
-    "opengl|directx]\n"
-    "                     [--range 0,-1|-1,1|0,1] [--alpha A] [--sigma-fine S] [--sigma-coarse S]\n"
-    "                     [--percentile-low P] [--percentile-high P] [--boundary "
-    "neumann|periodic]\n"
-    "                     [--tolerance T] [--max-iterations N]\n"
-    "                     [--relief-cutoff-texels N | --relief-cutoff-mm MM] [--mm-per-texel MM]\n"
-    "                     [--physical] [--paper-exact] [--mesh M [--scale S]] [--quiet]\n"
-    "  OUT.tiff/.tif: H_global as single-channel 32-bit float (invalid texels NaN)\n"
-    "  OUT.png:       8-bit preview, the range's low end black and high end white\n"
-    "  Defaults are the paper's: convention opengl, range -1,1, alpha 0.2, sigma-fine 0.35,\n"
-    "  sigma-coarse 1.1, percentiles 0.05 / 99.95; plus mean-slope removal and a relief\n"
-    "  high-pass: wavelengths above 64 texels (2 mm with --mm-per-texel) are drift, not relief\n"
-    "  (0 = keep all).\n"
-    "  --mm-per-texel: millimetres of surface per texel; with --physical H_global is in mm\n"
-    "                  (the relief the normal map implies) and beta becomes a gain.\n"
-    "  --paper-exact:  the paper's bake only (no high-pass, no mean-slope removal, periodic).\n"
-    "  --mesh M [--scale S]: the texture's mesh: its UV charts are the islands (texels outside\n"
-    "                  every chart invalid), its UV scale gives mm per texel, and islands get\n"
-    "                  offsets that make heights agree across the mesh's seams.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::valueOr;
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_bake",
+      "norm2tex_bake NORMAL_MAP -o OUT.(tiff|tif|png) [--mask M] [--convention opengl|directx]\n"
+      "                     [--range 0,-1|-1,1|0,1] [--alpha A] [--sigma-fine S] [--sigma-coarse "
+      "S]\n"
+      "                     [--percentile-low P] [--percentile-high P] [--boundary "
+      "neumann|periodic]\n"
+      "                     [--tolerance T] [--max-iterations N]\n"
+      "                     [--relief-cutoff-texels N | --relief-cutoff-mm MM] [--mm-per-texel "
+      "MM]\n"
+      "                     [--physical] [--paper-exact] [--mesh M [--scale S]] [--quiet]",
+      "Bakes a UV normal map into H_global, the global pseudo-height map of the texture\n"
+      "(Frankot-Chellappa per UV island, fine and coarse passes, percentile normalisation). An\n"
+      "OUT ending in .tiff or .tif gets H_global as single-channel 32-bit float (invalid texels\n"
+      "NaN); one ending in .png an 8-bit preview, the range's low end black and its high end\n"
+      "white. The defaults are the paper's, plus mean-slope removal and a relief high-pass:\n"
+      "wavelengths above 64 texels (2 mm with --mm-per-texel) are drift, not relief.");
+  program.positional("NORMAL_MAP", 1, po::value<std::string>());
+  program.add()  //
+      ("output,o", po::value<std::string>()->value_name("OUT"),
+       "The output file: .tiff or .tif (H_global, float), .png (preview).")  //
+      ("mask", po::value<std::string>()->value_name("M"),
+       "An image whose non-zero texels are the valid ones (default: the map's alpha).")  //
+      ("convention", po::value<std::string>()->value_name("opengl|directx"),
+       "The normal map's green axis convention (default opengl).")  //
+      ("range", po::value<std::string>()->value_name("0,-1|-1,1|0,1"),
+       "The height range H_global is normalised to (default -1,1).")  //
+      ("alpha", po::value<double>()->value_name("A"),
+       "H = (1 - A) H_fine + A H_coarse, in [0, 1] (default 0.2).")  //
+      ("sigma-fine", po::value<double>()->value_name("S"),
+       "Texels; the fine pass's Gaussian on the normals (default 0.35).")  //
+      ("sigma-coarse", po::value<double>()->value_name("S"),
+       "Texels; the coarse pass's Gaussian (default 1.1).")  //
+      ("percentile-low", po::value<double>()->value_name("P"),
+       "Percent; maps to the range's low end, outliers clipped (default 0.05).")  //
+      ("percentile-high", po::value<double>()->value_name("P"),
+       "Percent; maps to the range's high end (default 99.95).")  //
+      ("boundary", po::value<std::string>()->value_name("neumann|periodic"),
+       "The Poisson solve's boundary (default neumann; periodic with --paper-exact).")  //
+      ("tolerance", po::value<double>()->value_name("T"),
+       "The iterative solve's relative residual to reach (default 1e-4).")  //
+      ("max-iterations", po::value<int>()->value_name("N"),
+       "The iterative solve's iterations at most (default 300).")  //
+      ("relief-cutoff-texels", po::value<double>()->value_name("N"),
+       "The relief high-pass: longer wavelengths are drift (default 64; 0 keeps all).")  //
+      ("relief-cutoff-mm", po::value<double>()->value_name("MM"),
+       "The relief high-pass in mm of surface (default 2; needs --mm-per-texel).")  //
+      ("mm-per-texel", po::value<double>()->value_name("MM"),
+       "Millimetres of surface per texel; with --physical H_global is in mm (the relief the "
+       "normal map implies) and beta becomes a gain.")                                     //
+      ("physical", po::bool_switch(), "H_global in mm (needs --mm-per-texel or --mesh).")  //
+      ("paper-exact", po::bool_switch(),
+       "The paper's bake only: no high-pass, no mean-slope removal, periodic boundary.")  //
+      ("mesh", po::value<std::string>()->value_name("M"),
+       "The texture's mesh: its UV charts are the islands (texels outside every chart invalid), "
+       "its UV scale gives mm per texel, and islands get offsets that make heights agree across "
+       "the mesh's seams.")  //
+      ("scale", po::value<double>()->value_name("S"),
+       "The mesh's units to metres (default 1; 0.001 for a mesh in mm).")  //
+      ("quiet", po::bool_switch(), "Print nothing but errors and warnings.");
+  return program;
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -48,31 +92,31 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
+norm2tex::BakeOptions parseOptions(const po::variables_map& args) {
   norm2tex::BakeOptions options =
-      args.flag("--paper-exact") ? norm2tex::paperExactBakeOptions() : norm2tex::BakeOptions();
+      args["paper-exact"].as<bool>() ? norm2tex::paperExactBakeOptions() : norm2tex::BakeOptions();
   options.normal_map.convention =
-      norm2tex::parseNormalConvention(args.value("--convention", "opengl"));
-  options.range = norm2tex::parseHeightRange(args.value("--range", "-1,1"));
-  options.alpha = args.number("--alpha", options.alpha);
-  options.sigma_fine = args.number("--sigma-fine", options.sigma_fine);
-  options.sigma_coarse = args.number("--sigma-coarse", options.sigma_coarse);
-  options.percentile_low = args.number("--percentile-low", options.percentile_low);
-  options.percentile_high = args.number("--percentile-high", options.percentile_high);
-  options.integration.tolerance = args.number("--tolerance", options.integration.tolerance);
+      norm2tex::parseNormalConvention(valueOr<std::string>(args, "convention", "opengl"));
+  options.range = norm2tex::parseHeightRange(valueOr<std::string>(args, "range", "-1,1"));
+  options.alpha = valueOr(args, "alpha", options.alpha);
+  options.sigma_fine = valueOr(args, "sigma-fine", options.sigma_fine);
+  options.sigma_coarse = valueOr(args, "sigma-coarse", options.sigma_coarse);
+  options.percentile_low = valueOr(args, "percentile-low", options.percentile_low);
+  options.percentile_high = valueOr(args, "percentile-high", options.percentile_high);
+  options.integration.tolerance = valueOr(args, "tolerance", options.integration.tolerance);
   options.integration.max_iterations =
-      args.integer("--max-iterations", options.integration.max_iterations);
+      valueOr(args, "max-iterations", options.integration.max_iterations);
   options.relief_cutoff_texels =
-      args.number("--relief-cutoff-texels", options.relief_cutoff_texels);
-  options.relief_cutoff_mm = args.number("--relief-cutoff-mm", options.relief_cutoff_mm);
-  options.mm_per_texel = args.number("--mm-per-texel", options.mm_per_texel);
-  options.physical_scale = args.flag("--physical");
-  if (args.has("--relief-cutoff-mm") && !args.has("--mm-per-texel")) {
+      valueOr(args, "relief-cutoff-texels", options.relief_cutoff_texels);
+  options.relief_cutoff_mm = valueOr(args, "relief-cutoff-mm", options.relief_cutoff_mm);
+  options.mm_per_texel = valueOr(args, "mm-per-texel", options.mm_per_texel);
+  options.physical_scale = args["physical"].as<bool>();
+  if (args.count("relief-cutoff-mm") && !args.count("mm-per-texel")) {
     throw norm2tex::cli::UsageError("--relief-cutoff-mm needs --mm-per-texel");
   }
   const std::string default_boundary =
       options.integration.boundary == norm2tex::PoissonBoundary::kPeriodic ? "periodic" : "neumann";
-  const std::string boundary = args.value("--boundary", default_boundary);
+  const std::string boundary = valueOr(args, "boundary", default_boundary);
   // "mirror" is the old name of the cosine-transform (Neumann) solve.
   if (boundary == "neumann" || boundary == "mirror") {
     options.integration.boundary = norm2tex::PoissonBoundary::kNeumann;
@@ -83,7 +127,7 @@ norm2tex::BakeOptions parseOptions(const norm2tex::cli::Arguments& args) {
   }
   // With --mesh, mm per texel comes from the mesh (checked when it is known).
   norm2tex::BakeOptions checked = options;
-  if (args.has("--mesh") && checked.mm_per_texel == 0.0) checked.physical_scale = false;
+  if (args.count("mesh") && checked.mm_per_texel == 0.0) checked.physical_scale = false;
   norm2tex::validate(checked);
   return options;
 }
@@ -104,37 +148,26 @@ cv::Mat previewImage(const norm2tex::HeightAtlas& atlas, const norm2tex::BakeOpt
   return preview;
 }
 
-int run(int argc, char** argv) {
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   // Every large matrix of this short-lived process (the decoded PNG included) on huge pages.
   cv::Mat::setDefaultAllocator(norm2tex::hugePageAllocator());
-  const norm2tex::cli::Arguments args(
-      argc, argv,
-      {"-o", "--output", "--mask", "--convention", "--range", "--alpha", "--sigma-fine",
-       "--sigma-coarse", "--percentile-low", "--percentile-high", "--boundary", "--tolerance",
-       "--max-iterations", "--relief-cutoff-texels", "--relief-cutoff-mm", "--mm-per-texel",
-       "--mesh", "--scale"},
-      {"--quiet", "-h", "--help", "--physical", "--paper-exact"});
-  if (args.flag("-h") || args.flag("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
-  if (args.positional().size() != 1) {
-    throw norm2tex::cli::UsageError("expected exactly one NORMAL_MAP argument");
-  }
-  const std::string output = args.value("-o", args.value("--output", ""));
+  const po::variables_map args = program.parse(argc, argv);
+  if (!args.count("NORMAL_MAP")) throw norm2tex::cli::UsageError("missing NORMAL_MAP");
+  const std::string input = args["NORMAL_MAP"].as<std::string>();
+  const std::string output = valueOr<std::string>(args, "output", "");
   if (output.empty()) throw norm2tex::cli::UsageError("missing -o OUT");
   const std::string extension = norm2tex::lowerCaseExtension(output);
   if (extension != ".tiff" && extension != ".tif" && extension != ".png") {
     throw norm2tex::cli::UsageError("OUT must end in .tiff, .tif or .png, got '" + output + "'");
   }
-  const bool quiet = args.flag("--quiet");
+  const bool quiet = args["quiet"].as<bool>();
   const norm2tex::BakeOptions options = parseOptions(args);
 
   const auto start = Clock::now();
   const norm2tex::NormalMap normal_map = [&] {
     const norm2tex::cli::QuietStderr quiet_decoders;
-    return norm2tex::NormalMap::load(args.positional()[0], options.normal_map,
-                                     args.value("--mask", ""));
+    return norm2tex::NormalMap::load(input, options.normal_map,
+                                     valueOr<std::string>(args, "mask", ""));
   }();
   const double load_seconds = secondsSince(start);
 
@@ -155,11 +188,12 @@ int run(int argc, char** argv) {
   norm2tex::MeshBakeReport mesh_report;
   const norm2tex::BakeProgress shown = show_progress ? norm2tex::BakeProgress(progress) : nullptr;
   norm2tex::HeightAtlas atlas;
-  if (const auto mesh_path = args.value("--mesh")) {
+  if (args.count("mesh")) {
     // The mesh's UV charts are the islands, its scale sets mm per texel, seams are matched.
     norm2tex::MeshLoadOptions mesh_options;
-    mesh_options.scale = args.number("--scale", 1.0);
-    const norm2tex::TexturedMesh mesh = norm2tex::TexturedMesh::load(*mesh_path, mesh_options);
+    mesh_options.scale = valueOr(args, "scale", 1.0);
+    const norm2tex::TexturedMesh mesh =
+        norm2tex::TexturedMesh::load(args["mesh"].as<std::string>(), mesh_options);
     atlas = norm2tex::bakeHeightAtlasForMesh(normal_map, mesh, options, shown, &mesh_report);
     report = mesh_report.bake;
   } else {
@@ -176,8 +210,8 @@ int run(int argc, char** argv) {
     norm2tex::writeImage(output, std::move(atlas).takeHeightsInvalidAsNaN());
   }
   if (!quiet) {
-    std::printf("%s: %dx%d texels, %d valid, %d UV island%s\n", args.positional()[0].c_str(),
-                normal_map.cols(), normal_map.rows(), report.valid_texels, report.island_count,
+    std::printf("%s: %dx%d texels, %d valid, %d UV island%s\n", input.c_str(), normal_map.cols(),
+                normal_map.rows(), report.valid_texels, report.island_count,
                 report.island_count == 1 ? "" : "s");
     if (report.relief_cutoff_texels > 0.0) {
       std::printf("relief high-pass at %.4g texels; ", report.relief_cutoff_texels);
@@ -186,7 +220,7 @@ int run(int argc, char** argv) {
     }
     std::printf("%.0f %% of H_global's variance at wavelengths above 64 texels\n",
                 100.0 * long_wavelength_fraction);
-    if (args.has("--mesh")) {
+    if (args.count("mesh")) {
       std::printf(
           "mesh: %d UV charts, %.4g mm per texel; %d seam edges, step across seams %.1f%% -> "
           "%.1f%% of the relief amplitude after island offsets\n",
@@ -218,5 +252,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_bake", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -27,49 +26,49 @@ namespace {
 using norm2tex::Error;
 using norm2tex::cli::UsageError;
 
-constexpr const char* kUsage =
-    "usage: norm2tex_calibrate --background BG.png [BG2.png ...] --presses P1.png P2.png ...\n"
-    "                          --ball-diameter-mm D [--mm-per-pixel S] [--labels labels.csv]\n"
-    "                          [--size WxH] [--sensor base.yaml] [--holdout F]\n"
-    "                          -o SENSOR.yaml [--report REPORT.png]\n"
-    "  Fits a sensor yaml to your DIGIT: scale (unless --mm-per-pixel), the calibrated shading\n"
-    "  with its rim shadow, and the noise of your no-contact frames, which become the sensor's\n"
-    "  background (written beside the yaml as <name>_background.png).\n"
-    "  --background: no-contact frames (averaged); --presses: frames of one ball press each,\n"
-    "          at different places (at least 4; 10-50 recommended), portrait as your driver\n"
-    "          publishes them.\n"
-    "  --ball-diameter-mm: the pressing ball's diameter.\n"
-    "  --mm-per-pixel: the scale, if you know it (recommended); otherwise it is fitted, but\n"
-    "          ball presses pin it only weakly (the range that fits as well is printed).\n"
-    "  --labels: CSV lines 'file,centre_x_px,centre_y_px,radius_px' (file: as given or its base\n"
-    "          name, so paths from another machine work; an optional header line; CRLF is\n"
-    "          fine) for presses whose contact circle you know; the others are detected.\n"
-    "  --size WxH: resample every frame to this size first (e.g. 240x320 for VGA captures of a\n"
-    "          QVGA sensor). Default: the frames' own size.\n"
-    "  --sensor: the sensor yaml to start from (gel, camera); default: the built-in DIGIT.\n"
-    "  --holdout F: share of the presses held out to judge the fit (default 0.3).\n"
-    "  --report: a side-by-side image of held-out presses: real | render | difference.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::valueOr;
 
-// "--presses a b c" -> "--presses a --presses b --presses c", so that the argument parser sees
-// one value per option and shell globs just work.
-std::vector<std::string> expandLists(int argc, char** argv) {
-  std::vector<std::string> out = {argv[0]};
-  std::string list_option;
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "--background" || argument == "--presses") {
-      list_option = argument;
-      continue;
-    }
-    if (!list_option.empty() && (argument.empty() || argument[0] != '-')) {
-      out.push_back(list_option);
-      out.push_back(argument);
-      continue;
-    }
-    list_option.clear();
-    out.push_back(argument);
-  }
-  return out;
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_calibrate",
+      "norm2tex_calibrate --background BG.png [BG2.png ...] --presses P1.png P2.png ...\n"
+      "                          --ball-diameter-mm D [--mm-per-pixel S] [--labels labels.csv]\n"
+      "                          [--size WxH] [--sensor base.yaml] [--holdout F]\n"
+      "                          -o SENSOR.yaml [--report REPORT.png]",
+      "Fits a sensor yaml to your DIGIT from no-contact frames and a few ball presses: the scale\n"
+      "(unless --mm-per-pixel), the calibrated shading with its rim shadow, and the noise of\n"
+      "your no-contact frames, which become the sensor's background (written beside the yaml as\n"
+      "<name>_background.png).");
+  program.add()  //
+      ("background",
+       po::value<std::vector<std::string>>()->multitoken()->composing()->value_name("BG.png ..."),
+       "No-contact frames (averaged).")  //
+      ("presses",
+       po::value<std::vector<std::string>>()->multitoken()->composing()->value_name("P.png ..."),
+       "Frames of one ball press each, at different places (at least 4; 10-50 recommended), "
+       "portrait as your driver publishes them.")  //
+      ("ball-diameter-mm", po::value<double>()->value_name("D"),
+       "The pressing ball's diameter, mm.")  //
+      ("mm-per-pixel", po::value<double>()->value_name("S"),
+       "The scale, in (0, 1], if you know it (recommended); otherwise it is fitted, but ball "
+       "presses pin it only weakly (the range that fits as well is printed).")  //
+      ("labels", po::value<std::string>()->value_name("labels.csv"),
+       "CSV lines 'file,centre_x_px,centre_y_px,radius_px' (file: as given or its base name, so "
+       "paths from another machine work; an optional header line; CRLF is fine) for presses "
+       "whose contact circle you know; the others are detected.")  //
+      ("size", po::value<std::string>()->value_name("WxH"),
+       "Resample every frame to this size first (e.g. 240x320 for VGA captures of a QVGA "
+       "sensor). Default: the frames' own size.")  //
+      ("sensor", po::value<std::string>()->value_name("base.yaml"),
+       "The sensor yaml to start from (gel, camera); default: the built-in DIGIT.")  //
+      ("holdout", po::value<double>()->value_name("F"),
+       "The share of the presses held out to judge the fit (default 0.3).")  //
+      ("output,o", po::value<std::string>()->value_name("SENSOR.yaml"),
+       "The fitted sensor yaml.")  //
+      ("report", po::value<std::string>()->value_name("REPORT.png"),
+       "A side-by-side image of held-out presses: real | render | difference.");
+  return program;
 }
 
 cv::Size parseSize(const std::string& text) {
@@ -100,7 +99,7 @@ norm2tex::NamedFrame loadFrame(const std::string& path, const std::optional<cv::
 
 // The sensor to start from, at the frames' size: the built-in DIGIT at QVGA or VGA, or
 // --sensor's model; other sizes keep the gel and scale the pixels.
-norm2tex::SensorModel baseModel(const norm2tex::cli::Arguments& args, cv::Size frame_size) {
+norm2tex::SensorModel baseModel(const po::variables_map& args, cv::Size frame_size) {
   if (frame_size.width > frame_size.height) {
     throw Error("the first background frame is " + std::to_string(frame_size.width) + " x " +
                 std::to_string(frame_size.height) +
@@ -108,7 +107,7 @@ norm2tex::SensorModel baseModel(const norm2tex::cli::Arguments& args, cv::Size f
                 "driver publishes them); rotate your frames the way your driver does");
   }
   norm2tex::SensorModel model =
-      args.has("--sensor") ? norm2tex::loadSensorModel(*args.value("--sensor"))
+      args.count("sensor") ? norm2tex::loadSensorModel(args["sensor"].as<std::string>())
                            : norm2tex::makeDigitSensorModel(frame_size == cv::Size(480, 640));
   if (model.imageSize() != frame_size) {
     const double factor = static_cast<double>(model.cols) / frame_size.width;
@@ -153,49 +152,37 @@ void warnAboutFittedScale(const norm2tex::ShadingFit& fit) {
   }
 }
 
-int run(int argc, char** argv) {
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   // The fit renders thousands of presses through frame-sized temporaries: reused, not faulted
   // in afresh each time (~3x faster calibration).
   norm2tex::keepFreedMemoryForReuse();
-  std::vector<std::string> expanded = expandLists(argc, argv);
-  std::vector<char*> pointers;
-  for (std::string& argument : expanded) pointers.push_back(argument.data());
-  const norm2tex::cli::Arguments args(
-      static_cast<int>(pointers.size()), pointers.data(),
-      {"--background", "--presses", "--ball-diameter-mm", "--mm-per-pixel", "--labels", "--size",
-       "--sensor", "--holdout", "-o", "--report"},
-      {"-h", "--help"});
-  if (args.flag("-h") || args.flag("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
-  if (!args.positional().empty()) {
-    throw UsageError("unexpected argument '" + args.positional().front() + "'");
-  }
-  if (!args.has("--background")) throw UsageError("missing --background");
-  if (!args.has("--presses")) throw UsageError("missing --presses");
-  if (!args.has("--ball-diameter-mm")) throw UsageError("missing --ball-diameter-mm");
-  const std::string output = args.value("-o", "");
+  const po::variables_map args = program.parse(argc, argv);
+  if (!args.count("background")) throw UsageError("missing --background");
+  if (!args.count("presses")) throw UsageError("missing --presses");
+  if (!args.count("ball-diameter-mm")) throw UsageError("missing --ball-diameter-mm");
+  const std::string output = valueOr<std::string>(args, "output", "");
   if (output.empty()) throw UsageError("missing -o SENSOR.yaml");
 
   const auto start = std::chrono::steady_clock::now();
   std::optional<cv::Size> size;
-  if (const auto text = args.value("--size")) size = parseSize(*text);
+  if (args.count("size")) size = parseSize(args["size"].as<std::string>());
   norm2tex::CalibrationInput input;
-  for (const std::string& path : args.values("--background")) {
+  for (const std::string& path : args["background"].as<std::vector<std::string>>()) {
     input.backgrounds.push_back(loadFrame(path, size));
   }
-  for (const std::string& path : args.values("--presses")) {
+  for (const std::string& path : args["presses"].as<std::vector<std::string>>()) {
     input.presses.push_back(loadFrame(path, size));
   }
-  input.ball_diameter_mm = args.number("--ball-diameter-mm", 0.0);
-  if (args.has("--mm-per-pixel")) input.mm_per_pixel = args.number("--mm-per-pixel", 0.0);
+  input.ball_diameter_mm = args["ball-diameter-mm"].as<double>();
+  if (args.count("mm-per-pixel")) input.mm_per_pixel = args["mm-per-pixel"].as<double>();
   if (input.mm_per_pixel && !(*input.mm_per_pixel > 0.0 && *input.mm_per_pixel <= 1.0)) {
     throw UsageError("--mm-per-pixel must be in (0, 1]");
   }
-  if (const auto labels = args.value("--labels")) input.labels = loadLabels(*labels, input.presses);
+  if (args.count("labels")) {
+    input.labels = loadLabels(args["labels"].as<std::string>(), input.presses);
+  }
   norm2tex::CalibrationOptions options;
-  options.holdout_fraction = args.number("--holdout", options.holdout_fraction);
+  options.holdout_fraction = valueOr(args, "holdout", options.holdout_fraction);
 
   const norm2tex::SensorModel base = baseModel(args, input.backgrounds.front().image.size());
   const norm2tex::CalibrationResult result = norm2tex::calibrateSensor(base, input, options);
@@ -207,8 +194,8 @@ int run(int argc, char** argv) {
   norm2tex::SensorModel model = result.model;
   model.background_image = background_name;
   norm2tex::saveSensorModel(model, output);
-  if (const auto report = args.value("--report")) {
-    norm2tex::writeImage(*report, norm2tex::makeCalibrationReport(result));
+  if (args.count("report")) {
+    norm2tex::writeImage(args["report"].as<std::string>(), norm2tex::makeCalibrationReport(result));
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -227,5 +214,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_calibrate", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

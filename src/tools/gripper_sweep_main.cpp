@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -23,14 +22,25 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: norm2tex_gripper_sweep [--scene SCENE.yaml]... -o PLOT.png [--csv OUT.csv]\n"
-    "                              [--friction MU]\n"
-    "  Closes the gripper on each scene's object from its grasp opening in steps of 0.0025\n"
-    "  (300 ticks each) until the left gel carries 95 % of gripper.max_force_n, and plots\n"
-    "  force against indentation (with the gel law) and contact area against the command.\n"
-    "  --scene: a scene yaml, repeatable (default: config/scenes/cube.yaml and sphere.yaml).\n"
-    "  --csv: the raw rows. --friction MU: overrides every scene's object.friction.\n";
+namespace po = norm2tex::cli::po;
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_gripper_sweep",
+      "norm2tex_gripper_sweep [--scene SCENE.yaml]... -o PLOT.png [--csv OUT.csv]\n"
+      "                              [--friction MU]",
+      "Closes the gripper on each scene's object from its grasp opening in steps of 0.0025\n"
+      "(300 ticks each) until the left gel carries 95 % of gripper.max_force_n, and plots force\n"
+      "against indentation (with the gel law) and contact area against the command.");
+  program.add()  //
+      ("scene", po::value<std::vector<std::string>>()->composing()->value_name("SCENE.yaml"),
+       "A scene yaml, repeatable (default: config/scenes/cube.yaml and sphere.yaml).")  //
+      ("output,o", po::value<std::string>()->value_name("PLOT.png"), "The plot.")       //
+      ("csv", po::value<std::string>()->value_name("OUT.csv"), "The raw rows.")         //
+      ("friction", po::value<double>()->value_name("MU"),
+       "Overrides every scene's object.friction.");
+  return program;
+}
 
 constexpr double kOpeningStep = 0.0025;
 constexpr int kSettleTicks = 300;
@@ -239,19 +249,13 @@ cv::Mat3b plot(const std::vector<Scene>& scenes, const norm2tex::GelLaw& law,
   return image;
 }
 
-int run(int argc, char** argv) {
-  const norm2tex::cli::Arguments args(argc, argv, {"--scene", "-o", "--csv", "--friction"},
-                                      {"-h", "--help"});
-  if (args.flag("-h") || args.flag("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
-  if (!args.positional().empty())
-    throw norm2tex::cli::UsageError("unexpected argument '" + args.positional().front() + "'");
-  const std::string output = args.value("-o", "");
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  const po::variables_map args = program.parse(argc, argv);
+  const std::string output = norm2tex::cli::valueOr<std::string>(args, "output", "");
   if (output.empty()) throw norm2tex::cli::UsageError("missing -o PLOT.png");
   const std::string config_dir = norm2tex::cli::configDirectory();
-  std::vector<std::string> paths = args.values("--scene");
+  std::vector<std::string> paths =
+      norm2tex::cli::valueOr(args, "scene", std::vector<std::string>());
   if (paths.empty()) paths = {config_dir + "/scenes/cube.yaml", config_dir + "/scenes/sphere.yaml"};
   const norm2tex::SensorModel sensor = norm2tex::loadSensorModel(config_dir + "/digit.yaml");
 
@@ -260,7 +264,7 @@ int run(int argc, char** argv) {
   for (const std::string& path : paths) {
     norm2tex::GripperSimConfig config = norm2tex::loadGripperSimConfig(path);
     norm2tex::setGelFromSensor(sensor, config);
-    if (args.has("--friction")) config.object.friction = args.number("--friction", 0.0);
+    if (args.count("friction")) config.object.friction = args["friction"].as<double>();
     scenes.push_back({std::filesystem::path(path).stem().string(), sweep(config, sensor)});
     law = config.gel_law;  // the curve drawn is the last scene's law (the scenes share one)
 
@@ -278,8 +282,9 @@ int run(int argc, char** argv) {
         scenes.back().name.c_str(), rows.size(), max_f, max_d, 100.0 * worst);
   }
 
-  if (const auto csv_path = args.value("--csv")) {
-    std::ofstream csv(*csv_path);
+  if (args.count("csv")) {
+    const std::string csv_path = args["csv"].as<std::string>();
+    std::ofstream csv(csv_path);
     csv << "scene,opening,gap_mm,force_n,penetration_mm,area_mm2,law_force_n\n";
     for (const Scene& scene : scenes) {
       for (const Row& r : scene.rows) {
@@ -287,7 +292,7 @@ int run(int argc, char** argv) {
             << r.penetration_mm << ',' << r.area_mm2 << ',' << r.law_force_n << '\n';
       }
     }
-    if (!csv.flush()) throw norm2tex::Error("cannot write '" + *csv_path + "'");
+    if (!csv.flush()) throw norm2tex::Error("cannot write '" + csv_path + "'");
   }
   norm2tex::writeImage(output, plot(scenes, law, sensor));
   std::printf("wrote %s\n", output.c_str());
@@ -297,5 +302,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_gripper_sweep", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

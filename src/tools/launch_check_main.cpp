@@ -4,10 +4,7 @@
 // required node died), so what can be checked without the nodes is checked here, with the
 // nodes' own messages.
 //
-//   norm2tex_launch_check --launch NAME [--output-dir DIR [--min-free-mb MB]]
-//                         [--file WHAT=PATH ...]
-// Prints "ok" on stdout (the parameter's value) and exits 0, or prints one line
-// "NAME: <reason>" on stderr and exits 1. An empty PATH means "not given" and is not checked.
+// Its options and exit statuses: norm2tex_launch_check --help.
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -20,9 +17,46 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: norm2tex_launch_check --launch NAME [--output-dir DIR [--min-free-mb MB]]\n"
-    "                             [--file WHAT=PATH ...]\n";
+namespace po = norm2tex::cli::po;
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_launch_check",
+      "norm2tex_launch_check --launch NAME [--output-dir DIR [--min-free-mb MB]]\n"
+      "                             [--file WHAT=PATH ...]",
+      "Checks a launch file's arguments while roslaunch reads the file, before any node starts.\n"
+      "It prints \"ok\" on stdout (the value of the parameter that runs it) and exits 0, or\n"
+      "prints the one line \"NAME: <reason>\" on stderr and exits 1 (2 for a mistake in its own\n"
+      "arguments).");
+  program.add()  //
+      ("launch", po::value<std::string>()->value_name("NAME"),
+       "The launch file, named in every message.")  //
+      ("output-dir", po::value<std::string>()->value_name("DIR"),
+       "A directory a node will write to: it is made if needed and must be writable.")  //
+      ("min-free-mb", po::value<double>()->value_name("MB"),
+       "With --output-dir: the free space it must have, MB (default 0).")  //
+      ("file", po::value<std::vector<std::string>>()->composing()->value_name("WHAT=PATH"),
+       "A file a node will read, repeatable: it must exist, be a regular file and be readable. "
+       "An empty PATH means \"not given\" and is not checked, nor is a primitive mesh "
+       "(mesh=sphere:45).");
+  return program;
+}
+
+/// The launch file's name (--launch) read on its own, so that a message about another argument
+/// names the launch file too; the program's name when it is not there.
+std::string launchName(int argc, char** argv) {
+  po::options_description launch_only;
+  launch_only.add_options()("launch", po::value<std::string>());
+  try {
+    po::variables_map args;
+    po::store(po::command_line_parser(argc, argv).options(launch_only).allow_unregistered().run(),
+              args);
+    if (args.count("launch")) return args["launch"].as<std::string>();
+  } catch (const po::error&) {
+    // The full parse below says what is wrong.
+  }
+  return "norm2tex_launch_check";
+}
 
 /// A file a node will read: it must exist, be a regular file and be readable.
 void checkInputFile(const std::string& what_and_path) {
@@ -47,21 +81,25 @@ void checkInputFile(const std::string& what_and_path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string launch = "norm2tex_launch_check";
+  const norm2tex::cli::Program program = makeProgram();
+  if (norm2tex::cli::asksForHelp(argc, argv)) {
+    std::cout << program.help();
+    return 0;
+  }
+  // Messages name the launch file (they are roslaunch's), not this program.
+  const std::string launch = launchName(argc, argv);
   try {
-    const norm2tex::cli::Arguments args(
-        argc, argv, {"--launch", "--output-dir", "--min-free-mb", "--file"}, {});
-    launch = args.value("--launch", launch);
-    if (!args.positional().empty()) {
-      throw norm2tex::cli::UsageError("unexpected argument '" + args.positional().front() + "'");
+    const po::variables_map args = program.parse(argc, argv);
+    for (const std::string& file :
+         norm2tex::cli::valueOr(args, "file", std::vector<std::string>())) {
+      checkInputFile(file);
     }
-    for (const std::string& file : args.values("--file")) checkInputFile(file);
-    if (args.has("--output-dir")) {
-      norm2tex::checkOutputDirectory(*args.value("--output-dir"),
-                                     args.number("--min-free-mb", 0.0));
+    if (args.count("output-dir")) {
+      norm2tex::checkOutputDirectory(args["output-dir"].as<std::string>(),
+                                     norm2tex::cli::valueOr(args, "min-free-mb", 0.0));
     }
   } catch (const norm2tex::cli::UsageError& e) {
-    std::cerr << launch << ": " << e.what() << "\n" << kUsage;
+    std::cerr << launch << ": " << e.what() << "\n" << program.usage();
     return 2;
   } catch (const std::exception& e) {
     std::cerr << launch << ": " << e.what() << std::endl;

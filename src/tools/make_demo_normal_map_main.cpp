@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <iostream>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -18,14 +17,37 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: norm2tex_make_demo_normal_map -o OUT.png [--size PX] [--bits 8|16]\n"
-    "                                     [--convention opengl|directx] [--height-out H.tiff]\n"
-    "                                     [--one-island | --scan-like [--seed S]]\n"
-    "  --one-island: the same relief without alpha: every texel valid, one UV island.\n"
-    "  --scan-like: one island of random fine relief (wavelengths 3-40 texels) whose slopes\n"
-    "               carry a weak smooth bias (hundreds of texels), as photographed or scanned\n"
-    "               normal maps do; integrated, the bias becomes long-wavelength drift.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::valueOr;
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_make_demo_normal_map",
+      "norm2tex_make_demo_normal_map -o OUT.png [--size PX] [--bits 8|16]\n"
+      "                                     [--convention opengl|directx] [--height-out H.tiff]\n"
+      "                                     [--one-island | --scan-like [--seed S]]",
+      "Writes a UV-atlas-like normal map of known relief (waves, bumps and ridges on irregular\n"
+      "islands, alpha = island mask) to try the bake on. The relief is analytic, so the bake\n"
+      "can be checked by eye.");
+  program.add()                                                                         //
+      ("output,o", po::value<std::string>()->value_name("OUT.png"), "The normal map.")  //
+      ("size", po::value<int>()->value_name("PX"),
+       "Its width and height in texels, 64 to 8192 (default 512).")                     //
+      ("bits", po::value<int>()->value_name("8|16"), "Bits per channel (default 16).")  //
+      ("convention", po::value<std::string>()->value_name("opengl|directx"),
+       "The green axis convention (default opengl).")  //
+      ("height-out", po::value<std::string>()->value_name("H.tiff"),
+       "Also the true height, 32-bit float TIFF.")  //
+      ("one-island", po::bool_switch(),
+       "The same relief without alpha: every texel valid, one UV island.")  //
+      ("scan-like", po::bool_switch(),
+       "One island of random fine relief (wavelengths 3-40 texels) whose slopes carry a weak "
+       "smooth bias (hundreds of texels), as photographed or scanned normal maps do; "
+       "integrated, the bias becomes long-wavelength drift.")  //
+      ("seed", po::value<std::int64_t>()->value_name("S"),
+       "With --scan-like: the random seed (default 1).");
+  return program;
+}
 
 /// Smooth random field: white noise blurred with `sigma` texels, scaled to unit deviation.
 cv::Mat1f smoothNoise(cv::Size size, double sigma, cv::RNG& rng) {
@@ -55,29 +77,25 @@ norm2tex::AnalyticSurface scanLikeSurface(int size, std::uint64_t seed) {
   return surface;
 }
 
-int run(int argc, char** argv) {
-  const norm2tex::cli::Arguments args(
-      argc, argv, {"-o", "--size", "--bits", "--convention", "--height-out", "--seed"},
-      {"-h", "--help", "--scan-like", "--one-island"});
-  if (args.flag("-h") || args.flag("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
-  const std::string output = args.value("-o", "");
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  const po::variables_map args = program.parse(argc, argv);
+  const std::string output = valueOr<std::string>(args, "output", "");
   if (output.empty()) throw norm2tex::cli::UsageError("missing -o OUT.png");
-  const int size = args.integer("--size", 512);
-  const int bits = args.integer("--bits", 16);
+  const int size = valueOr(args, "size", 512);
+  const int bits = valueOr(args, "bits", 16);
   if (size < 64 || size > 8192) throw norm2tex::cli::UsageError("--size must be in [64, 8192]");
   if (bits != 8 && bits != 16) throw norm2tex::cli::UsageError("--bits must be 8 or 16");
-  const auto convention = norm2tex::parseNormalConvention(args.value("--convention", "opengl"));
+  const bool one_island = args["one-island"].as<bool>();
+  const auto convention =
+      norm2tex::parseNormalConvention(valueOr<std::string>(args, "convention", "opengl"));
 
-  if (args.flag("--scan-like")) {
+  if (args["scan-like"].as<bool>()) {
     const norm2tex::AnalyticSurface surface =
-        scanLikeSurface(size, static_cast<std::uint64_t>(args.integer("--seed", 1)));
+        scanLikeSurface(size, static_cast<std::uint64_t>(valueOr<std::int64_t>(args, "seed", 1)));
     norm2tex::writeImage(output, norm2tex::encodeNormalMap(surface.dx, surface.dy, convention,
                                                            bits == 8 ? CV_8U : CV_16U));
-    if (const auto height_out = args.value("--height-out")) {
-      norm2tex::writeImage(*height_out, surface.height);
+    if (args.count("height-out")) {
+      norm2tex::writeImage(args["height-out"].as<std::string>(), surface.height);
     }
     std::printf("wrote %s (%dx%d, %d-bit RGB, %s, scan-like: one island, slope bias 0.03)\n",
                 output.c_str(), size, size, bits, norm2tex::toString(convention).c_str());
@@ -101,20 +119,21 @@ int run(int argc, char** argv) {
   islands.convertTo(alpha, normals.depth(), bits == 8 ? 1.0 : 257.0);
   cv::Mat bgra;
   cv::merge(std::vector<cv::Mat>{normals, alpha}, bgra);
-  norm2tex::writeImage(output, args.flag("--one-island") ? normals : bgra);
-  if (const auto height_out = args.value("--height-out")) {
+  norm2tex::writeImage(output, one_island ? normals : bgra);
+  if (args.count("height-out")) {
     cv::Mat1f height = surface.height.clone();
     height.setTo(0.0f, islands == 0);
-    norm2tex::writeImage(*height_out, height);
+    norm2tex::writeImage(args["height-out"].as<std::string>(), height);
   }
   std::printf("wrote %s (%dx%d, %d-bit, %s, %s)\n", output.c_str(), size, size, bits,
               norm2tex::toString(convention).c_str(),
-              args.flag("--one-island") ? "RGB, one UV island" : "RGBA, 4 UV islands");
+              one_island ? "RGB, one UV island" : "RGBA, 4 UV islands");
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_make_demo_normal_map", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -32,25 +31,49 @@ namespace fs = std::filesystem;
 using norm2tex::Error;
 using norm2tex::cli::UsageError;
 
-constexpr const char* kUsage =
-    "usage: norm2tex_match_texture --background BG.png FRAME.png ... | DIR\n"
-    "                              (--material NAME | --normal-map N.png --mm-per-texel S)\n"
-    "                              [--forces F1,F2,... | --forces forces.csv] [--beta MM]\n"
-    "                              [--sensor SENSOR.yaml] [--tilt-deg A] -o OUT.yaml\n"
-    "                              [--report REPORT.png]\n"
-    "  Fits the texture depth beta_mm of a material to frames of your DIGIT pressing a flat\n"
-    "  sample of it (light to firm presses; tilt it slightly so part of the gel stays free).\n"
-    "  FRAME / DIR: the press frames (a directory: its .png/.jpg/.jpeg/.bmp/.tif/.tiff files,\n"
-    "          sorted by name); the background: your DIGIT's no-contact frame, same size.\n"
-    "  --material: a material of config/materials; --normal-map: your own texture, whose texels\n"
-    "          are --mm-per-texel mm on the surface (beta starts at --beta, default 0.1 mm).\n"
-    "  --forces: each frame's normal force (N), as a list in the frames' order or a CSV of\n"
-    "          'file,force_n' lines (file as given or its base name). Without forces each press\n"
-    "          is matched by its contact area and its force is the gel law's.\n"
-    "  --sensor: your DIGIT's yaml (norm2tex_calibrate); default the package's digit.yaml.\n"
-    "  --tilt-deg: the simulated sample's tilt (default 4); its contact grows from one edge.\n"
-    "  -o: the material yaml with the fitted beta_mm (for --normal-map: beta_mm and the map);\n"
-    "  --report: real vs simulated crops, band spectra and band RMS against force or area.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::valueOr;
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_match_texture",
+      "norm2tex_match_texture --background BG.png FRAME.png ... | DIR\n"
+      "                              (--material NAME | --normal-map N.png --mm-per-texel S)\n"
+      "                              [--forces F1,F2,... | --forces forces.csv] [--beta MM]\n"
+      "                              [--sensor SENSOR.yaml] [--tilt-deg A] -o OUT.yaml\n"
+      "                              [--report REPORT.png]",
+      "Fits the texture depth beta_mm of a material to frames of your DIGIT pressing a flat\n"
+      "sample of it (light to firm presses; tilt it slightly so part of the gel stays free).\n"
+      "FRAME / DIR are the press frames (a directory: its .png/.jpg/.jpeg/.bmp/.tif/.tiff\n"
+      "files, sorted by name).");
+  program.positional("FRAME", -1, po::value<std::vector<std::string>>());
+  program.add()  //
+      ("background", po::value<std::string>()->value_name("BG.png"),
+       "Your DIGIT's no-contact frame, the frames' size.")  //
+      ("material", po::value<std::string>()->value_name("NAME"),
+       "A material of config/materials.")  //
+      ("normal-map", po::value<std::string>()->value_name("N.png"),
+       "Your own texture, whose texels are --mm-per-texel mm on the surface (beta starts at "
+       "--beta, default 0.1 mm).")  //
+      ("mm-per-texel", po::value<double>()->value_name("S"),
+       "With --normal-map: its texels' size on the surface, mm.")  //
+      ("forces", po::value<std::string>()->value_name("F1,F2,...|forces.csv"),
+       "Each frame's normal force (N), as a list in the frames' order or a CSV of "
+       "'file,force_n' lines (file as given or its base name). Without forces each press is "
+       "matched by its contact area and its force is the gel law's.")  //
+      ("beta", po::value<double>()->value_name("MM"),
+       "The texture depth the fit starts from (default: the material's, 0.1 mm for a normal "
+       "map).")  //
+      ("sensor", po::value<std::string>()->value_name("SENSOR.yaml"),
+       "Your DIGIT's yaml (norm2tex_calibrate); default the package's digit.yaml.")  //
+      ("tilt-deg", po::value<double>()->value_name("A"),
+       "The simulated sample's tilt (default 4); its contact grows from one edge.")  //
+      ("output,o", po::value<std::string>()->value_name("OUT.yaml"),
+       "The material yaml with the fitted beta_mm (for --normal-map: beta_mm and the map).")  //
+      ("report", po::value<std::string>()->value_name("REPORT.png"),
+       "Real vs simulated crops, band spectra and band RMS against force or area.");
+  return program;
+}
 
 bool isImageFile(const fs::path& path) {
   std::string ext = path.extension().string();
@@ -183,63 +206,59 @@ void writeNormalMapYaml(const std::string& normal_map, double mm_per_texel,
   if (!out) throw Error("cannot write '" + output + "'");
 }
 
-int run(int argc, char** argv) {
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   norm2tex::keepFreedMemoryForReuse();
-  const norm2tex::cli::Arguments args(
-      argc, argv,
-      {"--background", "--forces", "--material", "--normal-map", "--mm-per-texel", "--beta",
-       "--sensor", "--tilt-deg", "-o", "--report"},
-      {"-h", "--help"});
-  if (!args.has("--background")) throw UsageError("missing --background");
-  if (args.positional().empty()) throw UsageError("no frames given");
-  if (args.has("--material") == args.has("--normal-map")) {
+  const po::variables_map args = program.parse(argc, argv);
+  if (!args.count("background")) throw UsageError("missing --background");
+  if (!args.count("FRAME")) throw UsageError("no frames given");
+  if (args.count("material") == args.count("normal-map")) {
     throw UsageError("give one of --material and --normal-map");
   }
-  if (args.has("--normal-map") && !args.has("--mm-per-texel")) {
+  if (args.count("normal-map") && !args.count("mm-per-texel")) {
     throw UsageError("--normal-map needs --mm-per-texel (its texels' size on the surface, mm)");
   }
-  const std::string output = args.value("-o", "");
+  const std::string output = valueOr<std::string>(args, "output", "");
   if (output.empty()) throw UsageError("missing -o OUT.yaml");
 
-  const std::vector<std::string> paths = framePaths(args.positional());
+  const std::vector<std::string> paths = framePaths(args["FRAME"].as<std::vector<std::string>>());
   std::vector<norm2tex::TextureFrame> frames;
   for (const std::string& path : paths) {
     frames.push_back({path, norm2tex::readImage(path, cv::IMREAD_COLOR, "frame"), {}});
   }
-  if (const auto forces = args.value("--forces")) {
-    const std::vector<double> values = loadForces(*forces, paths);
+  if (args.count("forces")) {
+    const std::vector<double> values = loadForces(args["forces"].as<std::string>(), paths);
     for (size_t i = 0; i < frames.size(); ++i) frames[i].normal_force_n = values[i];
   }
   const cv::Mat3b background =
-      norm2tex::readImage(*args.value("--background"), cv::IMREAD_COLOR, "background");
+      norm2tex::readImage(args["background"].as<std::string>(), cv::IMREAD_COLOR, "background");
   const std::string sensor_path =
-      args.value("--sensor", norm2tex::cli::configDirectory() + "/digit.yaml");
+      valueOr(args, "sensor", norm2tex::cli::configDirectory() + "/digit.yaml");
   const norm2tex::SensorModel model = norm2tex::loadSensorModel(sensor_path);
 
   std::string material_path;
   norm2tex::TextureSample sample;
-  if (const auto material = args.value("--material")) {
-    material_path = norm2tex::cli::materialConfigPath(*material);
+  const double mm_per_texel = valueOr(args, "mm-per-texel", 0.0);
+  if (args.count("material")) {
+    material_path = norm2tex::cli::materialConfigPath(args["material"].as<std::string>());
     sample = norm2tex::makeMaterialSample(norm2tex::loadMaterialConfig(material_path));
-    if (args.has("--beta")) sample.beta_mm = args.number("--beta", sample.beta_mm);
+    sample.beta_mm = valueOr(args, "beta", sample.beta_mm);
   } else {
-    sample = norm2tex::makeNormalMapSample(*args.value("--normal-map"),
-                                           args.number("--mm-per-texel", 0.0),
-                                           args.number("--beta", norm2tex::kFileTextureBetaMm));
+    sample = norm2tex::makeNormalMapSample(args["normal-map"].as<std::string>(), mm_per_texel,
+                                           valueOr(args, "beta", norm2tex::kFileTextureBetaMm));
   }
   norm2tex::TextureMatchOptions options;
-  options.tilt_deg = args.number("--tilt-deg", options.tilt_deg);
+  options.tilt_deg = valueOr(args, "tilt-deg", options.tilt_deg);
   const norm2tex::TextureMatchResult result =
       norm2tex::TextureMatcher(model, background, sample, options).fit(frames);
 
   if (!material_path.empty()) {
     writeMaterialYaml(material_path, output, result);
   } else {
-    writeNormalMapYaml(*args.value("--normal-map"), args.number("--mm-per-texel", 0.0), output,
-                       result);
+    writeNormalMapYaml(args["normal-map"].as<std::string>(), mm_per_texel, output, result);
   }
-  if (const auto report = args.value("--report")) {
-    norm2tex::writeImage(*report, norm2tex::makeTextureMatchReport(result, background));
+  if (args.count("report")) {
+    norm2tex::writeImage(args["report"].as<std::string>(),
+                         norm2tex::makeTextureMatchReport(result, background));
   }
   std::printf("%s: fitted on %zu frames\n", output.c_str(), frames.size());
   for (const std::string& line : norm2tex::describeTextureMatch(result)) {
@@ -251,5 +270,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_match_texture", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

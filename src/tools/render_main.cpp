@@ -1,8 +1,8 @@
 // norm2tex_render: one DIGIT frame of a mesh pressed into the gel, with or without texture.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -27,38 +27,72 @@
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: norm2tex_render --mesh M --pose \"x y z roll pitch yaw\" [--press-mm D]\n"
-    "                       [--normal-map N.png | --atlas H.tiff] [--beta MM] [--scale S]\n"
-    "                       [--material NAME] [--sensor digit.yaml] [--background BG.png]\n"
-    "                       [--seed S] [--no-noise] [--force-n F] [--conformity on|off]\n"
-    "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
-    "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
-    "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png\n"
-    "  --mesh: a mesh file (OBJ, STL, PLY, DAE, glTF/GLB) or a primitive: sphere:<radius_mm>,\n"
-    "          box:<x_mm>x<y_mm>x<z_mm>\n"
-    "  --pose: the object in the gel frame, metres and radians (roll, pitch, yaw about fixed\n"
-    "          x, y, z). Gel frame: origin at the centre of the undeformed gel surface, +x\n"
-    "          right (image columns), +y down (image rows), +z out of the gel towards the\n"
-    "          object. An object whose lowest point is at z = 0 just touches.\n"
-    "  --press-mm D: then move the object D mm along -z, into the gel.\n"
-    "  --normal-map: baked to H_global (cached on disk); --atlas: an H_global float TIFF.\n"
-    "          Without either, the mesh's own normal texture (glTF/OBJ material) is used.\n"
-    "  --material NAME: a procedural material (wood, fabric, rock, smooth, print3d) generated\n"
-    "          for the mesh's UVs at its true millimetre scale (a mesh without UVs is unwrapped\n"
-    "          first), with config/materials/NAME.yaml's parameters, range and beta.\n"
-    "  --beta: texture depth in mm (default: the material's; 1, a gain, for the mesh's own\n"
-    "          texture, baked in mm from the mesh's UV scale; else 0.2 mm; 0 = textureless,\n"
-    "          nothing is baked).\n"
-    "  --force-n F: the press's normal force, N (>= 0): how much of the texture the gel\n"
-    "          follows when the sensor's conformity is on; default: the gel law's force for\n"
-    "          the deepest indentation (the scenes' default law).\n"
-    "  --conformity on|off: overrides the sensor yaml's conformity.enabled (off: the paper's\n"
-    "          fixed-depth texture overlay).\n"
-    "  --scale: mesh units to metres (0.001 for meshes in mm; primitives ignore it).\n"
-    "  --depth-out: gel deformation, metres, 32-bit float TIFF. --mask-out: contact, mono8.\n"
-    "  --sheet: a contact sheet (grid PNG): one column per press depth, one row without\n"
-    "          texture, then one row per normal map.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::valueOr;
+
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_render",
+      "norm2tex_render --mesh M --pose \"x y z roll pitch yaw\" [--press-mm D]\n"
+      "                       [--normal-map N.png | --atlas H.tiff] [--beta MM] [--scale S]\n"
+      "                       [--material NAME] [--sensor digit.yaml] [--background BG.png]\n"
+      "                       [--seed S] [--no-noise] [--force-n F] [--conformity on|off]\n"
+      "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
+      "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
+      "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png",
+      "Renders one DIGIT frame of a mesh pressed into the gel, with or without texture, or a\n"
+      "contact sheet of several press depths and normal maps (--sheet).");
+  program.add()  //
+      ("mesh", po::value<std::string>()->value_name("M"),
+       "A mesh file (OBJ, STL, PLY, DAE, glTF/GLB) or a primitive: sphere:<radius_mm>, "
+       "box:<x_mm>x<y_mm>x<z_mm>.")  //
+      ("pose", po::value<std::string>()->value_name("\"x y z roll pitch yaw\""),
+       "The object in the gel frame, metres and radians (roll, pitch, yaw about fixed x, y, z). "
+       "Gel frame: origin at the centre of the undeformed gel surface, +x right (image "
+       "columns), +y down (image rows), +z out of the gel towards the object. An object whose "
+       "lowest point is at z = 0 just touches.")  //
+      ("press-mm", po::value<double>()->value_name("D"),
+       "Then move the object D mm along -z, into the gel.")  //
+      ("normal-map", po::value<std::string>()->value_name("N.png"),
+       "A normal map, baked to H_global (cached on disk); with --sheet a comma-separated list. "
+       "Without --normal-map, --atlas or --material, the mesh's own normal texture (glTF/OBJ "
+       "material) is used.")                                                                //
+      ("atlas", po::value<std::string>()->value_name("H.tiff"), "An H_global float TIFF.")  //
+      ("material", po::value<std::string>()->value_name("NAME"),
+       "A procedural material (wood, fabric, rock, smooth, print3d) generated for the mesh's UVs "
+       "at its true millimetre scale (a mesh without UVs is unwrapped first), with "
+       "config/materials/NAME.yaml's parameters, range and beta.")  //
+      ("beta", po::value<double>()->value_name("MM"),
+       "Texture depth in mm (default: the material's; 1, a gain, for the mesh's own texture, "
+       "baked in mm from the mesh's UV scale; else 0.2 mm, 0.1 mm with --sheet; 0 = "
+       "textureless, nothing is baked).")  //
+      ("scale", po::value<double>()->value_name("S"),
+       "Mesh units to metres (0.001 for meshes in mm; primitives ignore it).")  //
+      ("sensor", po::value<std::string>()->value_name("digit.yaml"),
+       "The sensor yaml (default: the built-in DIGIT).")  //
+      ("background", po::value<std::string>()->value_name("BG.png"),
+       "The sensor's no-contact frame (default: the sensor yaml's).")  //
+      ("seed", po::value<std::int64_t>()->value_name("S"),
+       "The seed of the sensor noise and of the material (default 0).")  //
+      ("no-noise", po::bool_switch(), "No sensor noise.")                //
+      ("force-n", po::value<double>()->value_name("F"),
+       "The press's normal force, N (>= 0): how much of the texture the gel follows when the "
+       "sensor's conformity is on; default: the gel law's force for the deepest indentation "
+       "(the scenes' default law).")  //
+      ("conformity", po::value<std::string>()->value_name("on|off"),
+       "Overrides the sensor yaml's conformity.enabled (off: the paper's fixed-depth texture "
+       "overlay).")                                                                           //
+      ("output,o", po::value<std::string>()->value_name("OUT.png"), "The image (or sheet).")  //
+      ("depth-out", po::value<std::string>()->value_name("D.tiff"),
+       "Gel deformation, metres, 32-bit float TIFF.")                                 //
+      ("mask-out", po::value<std::string>()->value_name("M.png"), "Contact, mono8.")  //
+      ("sheet", po::bool_switch(),
+       "A contact sheet (grid PNG): one column per press depth, one row without texture, then "
+       "one row per normal map.")  //
+      ("presses", po::value<std::string>()->value_name("0.5,1,1.5"),
+       "With --sheet: the press depths, mm (default 0.5,1.0,1.5).");
+  return program;
+}
 
 std::shared_ptr<const norm2tex::TexturedMesh> loadMesh(const std::string& spec, double scale) {
   const bool primitive = spec.rfind("sphere:", 0) == 0 || spec.rfind("box:", 0) == 0;
@@ -116,28 +150,29 @@ std::vector<std::string> splitList(const std::string& text) {
   return items;
 }
 
-norm2tex::ObjectTexture loadAtlas(const norm2tex::cli::Arguments& args,
+norm2tex::ObjectTexture loadAtlas(const po::variables_map& args,
                                   const norm2tex::TexturedMesh& mesh) {
   norm2tex::TextureSource source;
-  source.atlas = args.value("--atlas", "");
-  if (source.atlas.empty()) source.normal_map = args.value("--normal-map", "");
+  source.atlas = valueOr<std::string>(args, "atlas", "");
+  if (source.atlas.empty()) source.normal_map = valueOr<std::string>(args, "normal-map", "");
   return loadTextureWithWarning(source, mesh);
 }
 
 /// --sheet: rows = no texture, then each normal map; columns = press depths.
-int renderSheet(const norm2tex::cli::Arguments& args, const norm2tex::SensorModel& model,
+int renderSheet(const po::variables_map& args, const norm2tex::SensorModel& model,
                 std::shared_ptr<const norm2tex::TexturedMesh> mesh, const std::string& output) {
   std::vector<double> presses;
-  for (const std::string& item : splitList(args.value("--presses", "0.5,1.0,1.5"))) {
+  for (const std::string& item : splitList(valueOr<std::string>(args, "presses", "0.5,1.0,1.5"))) {
     std::istringstream text(item);
     double press = 0;
-    if (!(text >> press))
+    if (!(text >> press) || !(text >> std::ws).eof() || !std::isfinite(press))
       throw norm2tex::cli::UsageError("--presses: not a number: '" + item + "'");
     presses.push_back(press);
   }
-  const std::vector<std::string> maps = splitList(args.value("--normal-map", ""));
-  const double beta = args.number("--beta", 0.1);
-  const std::int64_t seed = args.flag("--no-noise") ? -1 : args.integer("--seed", 0);
+  const std::vector<std::string> maps = splitList(valueOr<std::string>(args, "normal-map", ""));
+  const double beta = valueOr(args, "beta", 0.1);
+  const std::int64_t seed =
+      args["no-noise"].as<bool>() ? -1 : valueOr<std::int64_t>(args, "seed", 0);
   const auto shortNumber = [](double value) {
     std::ostringstream text;
     text << value;
@@ -147,12 +182,12 @@ int renderSheet(const norm2tex::cli::Arguments& args, const norm2tex::SensorMode
   std::vector<std::vector<cv::Mat3b>> tiles;
   std::vector<std::string> row_labels{"no texture"}, column_labels;
   for (const double press : presses) column_labels.push_back("press " + shortNumber(press) + " mm");
+  const std::string pose = args["pose"].as<std::string>();
   const auto addRow = [&](std::shared_ptr<const norm2tex::HeightAtlas> atlas) {
     renderer.setObject(mesh, atlas, atlas ? beta : 0.0);
     tiles.emplace_back();
     for (const double press : presses) {
-      tiles.back().push_back(
-          renderer.render(parsePose(*args.value("--pose"), press), seed).image.clone());
+      tiles.back().push_back(renderer.render(parsePose(pose, press), seed).image.clone());
     }
   };
   addRow(nullptr);
@@ -171,72 +206,63 @@ int renderSheet(const norm2tex::cli::Arguments& args, const norm2tex::SensorMode
   return 0;
 }
 
-int run(int argc, char** argv) {
-  const norm2tex::cli::Arguments args(
-      argc, argv,
-      {"--mesh", "--pose", "--press-mm", "--normal-map", "--atlas", "--beta", "--scale", "--sensor",
-       "--background", "--seed", "-o", "--depth-out", "--mask-out", "--presses", "--material",
-       "--force-n", "--conformity"},
-      {"--no-noise", "--sheet", "-h", "--help"});
-  if (args.flag("-h") || args.flag("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
-  if (!args.has("--mesh")) throw norm2tex::cli::UsageError("missing --mesh");
-  if (!args.has("--pose")) throw norm2tex::cli::UsageError("missing --pose");
-  const std::string output = args.value("-o", "");
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  const po::variables_map args = program.parse(argc, argv);
+  if (!args.count("mesh")) throw norm2tex::cli::UsageError("missing --mesh");
+  if (!args.count("pose")) throw norm2tex::cli::UsageError("missing --pose");
+  const std::string output = valueOr<std::string>(args, "output", "");
   if (output.empty()) throw norm2tex::cli::UsageError("missing -o OUT.png");
-  if (!args.flag("--sheet") && args.value("--normal-map", "").find(',') != std::string::npos) {
+  const bool sheet = args["sheet"].as<bool>();
+  const std::string mesh_spec = args["mesh"].as<std::string>();
+  if (!sheet && valueOr<std::string>(args, "normal-map", "").find(',') != std::string::npos) {
     throw norm2tex::cli::UsageError("several --normal-map files only with --sheet");
   }
-  if (args.has("--material") + args.has("--normal-map") + args.has("--atlas") > 1) {
+  if (args.count("material") + args.count("normal-map") + args.count("atlas") > 1) {
     throw norm2tex::cli::UsageError("give one of --material, --normal-map and --atlas");
-  }
-  if (args.has("--normal-map") && args.has("--atlas")) {
-    throw norm2tex::cli::UsageError("give --normal-map or --atlas, not both");
   }
   // Before any work or any file written: depth is float, the image 8-bit colour.
   norm2tex::requireFormatHolds(output, CV_8UC3);
-  if (const auto depth_out = args.value("--depth-out")) {
-    norm2tex::requireFormatHolds(*depth_out, CV_32FC1);
+  if (args.count("depth-out")) {
+    norm2tex::requireFormatHolds(args["depth-out"].as<std::string>(), CV_32FC1);
   }
 
-  norm2tex::SensorModel model = args.has("--sensor")
-                                    ? norm2tex::loadSensorModel(*args.value("--sensor"))
+  norm2tex::SensorModel model = args.count("sensor")
+                                    ? norm2tex::loadSensorModel(args["sensor"].as<std::string>())
                                     : norm2tex::makeDigitSensorModel();
-  if (const auto background = args.value("--background")) model.background_image = *background;
-  if (const auto conformity = args.value("--conformity")) {
-    if (*conformity != "on" && *conformity != "off") {
-      throw norm2tex::cli::UsageError("--conformity: '" + *conformity + "'; valid: on, off");
+  if (args.count("background")) model.background_image = args["background"].as<std::string>();
+  if (args.count("conformity")) {
+    const std::string conformity = args["conformity"].as<std::string>();
+    if (conformity != "on" && conformity != "off") {
+      throw norm2tex::cli::UsageError("--conformity: '" + conformity + "'; valid: on, off");
     }
-    model.conformity.enabled = *conformity == "on";
+    model.conformity.enabled = conformity == "on";
   }
   std::optional<double> force_n;
-  if (args.has("--force-n")) force_n = args.number("--force-n", 0.0);
-  const auto pose = parsePose(*args.value("--pose"), args.number("--press-mm", 0.0));
+  if (args.count("force-n")) force_n = args["force-n"].as<double>();
+  const auto pose = parsePose(args["pose"].as<std::string>(), valueOr(args, "press-mm", 0.0));
   std::shared_ptr<const norm2tex::TexturedMesh> mesh = [&] {
     const norm2tex::cli::QuietStderr quiet_decoders;
-    return loadMesh(*args.value("--mesh"), args.number("--scale", 1.0));
+    return loadMesh(mesh_spec, valueOr(args, "scale", 1.0));
   }();
-  if (args.flag("--sheet")) return renderSheet(args, model, mesh, output);
+  if (sheet) return renderSheet(args, model, mesh, output);
   std::shared_ptr<const norm2tex::HeightAtlas> atlas;
   double default_beta = 0.2;
   bool physical_scale = false;  // the atlas holds mm: beta is a gain
   // --beta 0 is a textureless render: nothing to generate or bake.
-  const bool textureless = args.has("--beta") && args.number("--beta", 0.0) == 0.0;
+  const bool textureless = args.count("beta") && args["beta"].as<double>() == 0.0;
   if (textureless) {
     // No texture to load.
-  } else if (const auto material = args.value("--material")) {
+  } else if (args.count("material")) {
     // The material is generated for this mesh's own UV layout, so its scale in mm is right.
-    const norm2tex::MaterialConfig config =
-        norm2tex::loadMaterialConfig(norm2tex::cli::materialConfigPath(*material));
+    const norm2tex::MaterialConfig config = norm2tex::loadMaterialConfig(
+        norm2tex::cli::materialConfigPath(args["material"].as<std::string>()));
     norm2tex::TexturedMesh textured = *mesh;
-    if (args.value("--mesh")->rfind("sphere:", 0) == 0) {
+    if (mesh_spec.rfind("sphere:", 0) == 0) {
       // The UV sphere's equirectangular UVs stretch 2:1; an unwrapped copy keeps mm true.
       textured = norm2tex::TexturedMesh(mesh->vertices(), mesh->triangles());
     }
     atlas = std::make_shared<norm2tex::HeightAtlas>(norm2tex::bakeMaterialAtlas(
-        config, static_cast<std::uint64_t>(args.integer("--seed", 0)), textured));
+        config, static_cast<std::uint64_t>(valueOr<std::int64_t>(args, "seed", 0)), textured));
     mesh = std::make_shared<const norm2tex::TexturedMesh>(std::move(textured));
     default_beta = config.beta_mm;
   } else {
@@ -248,12 +274,13 @@ int run(int argc, char** argv) {
     physical_scale = texture.physical_scale;
     if (atlas) std::printf("texture: %s\n", texture.description.c_str());
   }
-  const double beta = args.number("--beta", atlas ? default_beta : 0.0);
+  const double beta = valueOr(args, "beta", atlas ? default_beta : 0.0);
 
   norm2tex::TactileRenderer renderer(model);
   const std::string warning = renderer.setObject(mesh, atlas, beta);
   if (!warning.empty()) std::fprintf(stderr, "norm2tex_render: warning: %s\n", warning.c_str());
-  const std::int64_t seed = args.flag("--no-noise") ? -1 : args.integer("--seed", 0);
+  const std::int64_t seed =
+      args["no-noise"].as<bool>() ? -1 : valueOr<std::int64_t>(args, "seed", 0);
 
   const auto start = std::chrono::steady_clock::now();
   const norm2tex::TactileFrame& frame = renderer.render(pose, seed, force_n);
@@ -261,10 +288,12 @@ int run(int argc, char** argv) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
   norm2tex::writeImage(output, frame.image);
-  if (const auto depth_out = args.value("--depth-out"))
-    norm2tex::writeImage(*depth_out, frame.depthMetres());
-  if (const auto mask_out = args.value("--mask-out"))
-    norm2tex::writeImage(*mask_out, frame.contact_mask);
+  if (args.count("depth-out")) {
+    norm2tex::writeImage(args["depth-out"].as<std::string>(), frame.depthMetres());
+  }
+  if (args.count("mask-out")) {
+    norm2tex::writeImage(args["mask-out"].as<std::string>(), frame.contact_mask);
+  }
   char texture[96] = "textureless";
   if (frame.textured) {
     std::snprintf(
@@ -289,5 +318,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_render", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,31 +31,69 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-constexpr const char* kUsage =
-    "usage: norm2tex_texgen --material NAME [--config M.yaml] [--param key=value ...] [--seed S]\n"
-    "                       [--size PX | --mm-per-texel R] [--bits 8|16] [--mesh IN [--scale S]]\n"
-    "                       [--out-mesh OUT.obj] -o NORMAL.png [--albedo A.png] [--height-out "
-    "H.tiff]\n"
-    "       norm2tex_texgen --material NAME --variants K --out-dir DIR [--seed S] [...]\n"
-    "       norm2tex_texgen --list\n"
-    "       norm2tex_texgen --gallery -o GALLERY.png [--seed S]\n"
-    "  NAME: wood, fabric, rock, smooth, print3d. Defaults (parameters, beta, range, texture\n"
-    "  size and mm per texel) come from config/materials/NAME.yaml; --param overrides one\n"
-    "  parameter (see --list for names, units and ranges).\n"
-    "  --mesh: a texture for that mesh. With UVs, every UV island gets the relief at its own\n"
-    "  millimetre scale, in the atlas the nodes use (the smallest of size, size/2, ... whose\n"
-    "  texels are at most mm per texel on the mesh; --size forces a size); without, the mesh\n"
-    "  is unwrapped into a new atlas of size texels and written to --out-mesh (default:\n"
-    "  NORMAL_mesh.obj) with a material that references NORMAL.png.\n"
-    "  --variants K: K variants drawn from the config's variant ranges, NAME_NN_normal.png and\n"
-    "  NAME_NN_albedo.png in DIR with variants.yaml listing their parameters.\n";
+namespace po = norm2tex::cli::po;
+using norm2tex::cli::valueOr;
 
-norm2tex::MaterialConfig loadConfig(const norm2tex::cli::Arguments& args,
-                                    const std::string& material) {
-  const std::string path =
-      args.has("--config") ? *args.value("--config") : norm2tex::cli::materialConfigPath(material);
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_texgen",
+      "norm2tex_texgen --material NAME [--config M.yaml] [--param key=value ...] [--seed S]\n"
+      "                       [--size PX | --mm-per-texel R] [--bits 8|16] [--mesh IN [--scale "
+      "S]]\n"
+      "                       [--out-mesh OUT.obj] [--padding PX] -o NORMAL.png [--albedo A.png]\n"
+      "                       [--height-out H.tiff]\n"
+      "       norm2tex_texgen --material NAME --variants K --out-dir DIR [--seed S] [...]\n"
+      "       norm2tex_texgen --list\n"
+      "       norm2tex_texgen --gallery -o GALLERY.png [--seed S]",
+      "Generates a procedural material's normal map (and its albedo, height and, for a mesh\n"
+      "without UVs, the UV-unwrapped mesh), variants of it, or the gallery of every material\n"
+      "through the tactile renderer. NAME is wood, fabric, rock, smooth or print3d; its defaults\n"
+      "(parameters, beta, range, texture size and mm per texel) come from\n"
+      "config/materials/NAME.yaml.");
+  program.add()                                                                    //
+      ("material", po::value<std::string>()->value_name("NAME"), "The material.")  //
+      ("config", po::value<std::string>()->value_name("M.yaml"),
+       "A material yaml instead of config/materials/NAME.yaml.")  //
+      ("param", po::value<std::vector<std::string>>()->composing()->value_name("key=value"),
+       "Overrides one parameter; repeatable (see --list for names, units and ranges).")     //
+      ("seed", po::value<std::int64_t>()->value_name("S"), "The random seed (default 1).")  //
+      ("size", po::value<int>()->value_name("PX"),
+       "The texture's size in texels (default: the material's).")  //
+      ("mm-per-texel", po::value<double>()->value_name("R"),
+       "Millimetres of surface per texel (default: the material's).")                        //
+      ("bits", po::value<int>()->value_name("8|16"), "The normal map's bits (default 16).")  //
+      ("mesh", po::value<std::string>()->value_name("IN"),
+       "A texture for that mesh. With UVs, every UV island gets the relief at its own "
+       "millimetre scale, in the atlas the nodes use (the smallest of size, size/2, ... whose "
+       "texels are at most mm per texel on the mesh; --size forces a size); without, the mesh "
+       "is unwrapped into a new atlas of size texels and written to --out-mesh with a material "
+       "that references NORMAL.png.")  //
+      ("scale", po::value<double>()->value_name("S"),
+       "The mesh's units to metres (default 1; 0.001 for a mesh in mm).")  //
+      ("out-mesh", po::value<std::string>()->value_name("OUT.obj"),
+       "Where the unwrapped mesh goes (default: NORMAL_mesh.obj).")  //
+      ("padding", po::value<int>()->value_name("PX"),
+       "Texels of padding around each UV island (default 4).")  //
+      ("output,o", po::value<std::string>()->value_name("NORMAL.png"),
+       "The normal map (with --gallery: the gallery).")                              //
+      ("albedo", po::value<std::string>()->value_name("A.png"), "Also the albedo.")  //
+      ("height-out", po::value<std::string>()->value_name("H.tiff"),
+       "Also the height, mm, 32-bit float TIFF.")  //
+      ("variants", po::value<int>()->value_name("K"),
+       "K variants (1 to 1000) drawn from the config's variant ranges, NAME_NN_normal.png and "
+       "NAME_NN_albedo.png in --out-dir with variants.yaml listing their parameters.")  //
+      ("out-dir", po::value<std::string>()->value_name("DIR"), "Where --variants go.")  //
+      ("list", po::bool_switch(), "List the materials and their parameters.")           //
+      ("gallery", po::bool_switch(),
+       "Every material through the tactile renderer: albedo, normal map, no texture, texture.");
+  return program;
+}
+
+norm2tex::MaterialConfig loadConfig(const po::variables_map& args, const std::string& material) {
+  const std::string path = args.count("config") ? args["config"].as<std::string>()
+                                                : norm2tex::cli::materialConfigPath(material);
   norm2tex::MaterialConfig config = norm2tex::loadMaterialConfig(path);
-  for (const std::string& assignment : args.values("--param")) {
+  for (const std::string& assignment : valueOr(args, "param", std::vector<std::string>())) {
     const size_t equals = assignment.find('=');
     if (equals == std::string::npos) {
       throw norm2tex::cli::UsageError("--param expects key=value, got '" + assignment + "'");
@@ -64,7 +101,7 @@ norm2tex::MaterialConfig loadConfig(const norm2tex::cli::Arguments& args,
     char* end = nullptr;
     const std::string text = assignment.substr(equals + 1);
     const double value = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0') {
+    if (text.empty() || *end != '\0' || !std::isfinite(value)) {
       throw norm2tex::cli::UsageError("--param " + assignment.substr(0, equals) +
                                       " expects a number, got '" + text + "'");
     }
@@ -100,11 +137,11 @@ void writeVariantsManifest(
   if (!out) throw norm2tex::Error("cannot write '" + path + "'");
 }
 
-int writeVariants(const norm2tex::cli::Arguments& args, const norm2tex::MaterialConfig& config,
+int writeVariants(const po::variables_map& args, const norm2tex::MaterialConfig& config,
                   std::uint64_t seed, int size, double mm_per_texel, int depth) {
-  const int count = args.integer("--variants", 0);
+  const int count = args["variants"].as<int>();
   if (count < 1 || count > 1000) throw norm2tex::cli::UsageError("--variants must be in [1, 1000]");
-  const std::string dir = args.value("--out-dir", "");
+  const std::string dir = valueOr<std::string>(args, "out-dir", "");
   if (dir.empty()) throw norm2tex::cli::UsageError("--variants needs --out-dir DIR");
   fs::create_directories(dir);
   std::vector<std::unique_ptr<norm2tex::ProceduralMaterial>> variants;
@@ -175,8 +212,7 @@ std::vector<cv::Mat3b> galleryRow(const norm2tex::MaterialConfig& config, std::u
   return row;
 }
 
-int writeGallery(const norm2tex::cli::Arguments& args, const std::string& output,
-                 std::uint64_t seed) {
+int writeGallery(const po::variables_map& args, const std::string& output, std::uint64_t seed) {
   norm2tex::TactileRenderer renderer(norm2tex::makeDigitSensorModel());
   std::vector<std::vector<cv::Mat3b>> tiles;
   std::vector<std::string> labels;
@@ -194,59 +230,50 @@ int writeGallery(const norm2tex::cli::Arguments& args, const std::string& output
   return 0;
 }
 
-int run(int argc, char** argv) {
-  const norm2tex::cli::Arguments args(
-      argc, argv,
-      {"--material", "--config", "--param", "--seed", "--size", "--mm-per-texel", "--bits",
-       "--mesh", "--scale", "--out-mesh", "-o", "--albedo", "--height-out", "--variants",
-       "--out-dir", "--padding"},
-      {"--list", "--gallery", "-h", "--help"});
-  if (args.flag("-h") || args.flag("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
-  if (args.flag("--list")) {
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  const po::variables_map args = program.parse(argc, argv);
+  if (args["list"].as<bool>()) {
     listMaterials();
     return 0;
   }
-  const std::uint64_t seed = static_cast<std::uint64_t>(args.integer("--seed", 1));
-  const std::string output = args.value("-o", "");
-  if (args.flag("--gallery")) {
+  const std::uint64_t seed = static_cast<std::uint64_t>(valueOr<std::int64_t>(args, "seed", 1));
+  const std::string output = valueOr<std::string>(args, "output", "");
+  if (args["gallery"].as<bool>()) {
     if (output.empty()) throw norm2tex::cli::UsageError("--gallery needs -o GALLERY.png");
     return writeGallery(args, output, seed);
   }
-  const std::string name = args.value("--material", "");
+  const std::string name = valueOr<std::string>(args, "material", "");
   if (name.empty()) throw norm2tex::cli::UsageError("missing --material NAME");
   const norm2tex::MaterialConfig config = loadConfig(args, name);
-  const int bits = args.integer("--bits", 16);
+  const int bits = valueOr(args, "bits", 16);
   if (bits != 8 && bits != 16) throw norm2tex::cli::UsageError("--bits must be 8 or 16");
   const int depth = bits == 8 ? CV_8U : CV_16U;
-  if (args.has("--size") && args.has("--mm-per-texel") && !args.has("--mesh")) {
+  if (args.count("size") && args.count("mm-per-texel") && !args.count("mesh")) {
     throw norm2tex::cli::UsageError("give --size or --mm-per-texel, not both");
   }
-  const double mm_per_texel = args.number("--mm-per-texel", config.mm_per_texel);
-  const int size = args.integer("--size", config.size);
-  if (args.has("--variants")) return writeVariants(args, config, seed, size, mm_per_texel, depth);
+  const double mm_per_texel = valueOr(args, "mm-per-texel", config.mm_per_texel);
+  const int size = valueOr(args, "size", config.size);
+  if (args.count("variants")) return writeVariants(args, config, seed, size, mm_per_texel, depth);
   if (output.empty()) throw norm2tex::cli::UsageError("missing -o NORMAL.png");
 
   const auto start = Clock::now();
   const auto material = norm2tex::makeMaterialVariant(config, 0, seed);
   norm2tex::MaterialTexture texture;
   std::string mesh_note;
-  if (const auto mesh_path = args.value("--mesh")) {
+  if (args.count("mesh")) {
     norm2tex::MeshLoadOptions load_options;
-    load_options.scale = args.number("--scale", 1.0);
+    load_options.scale = valueOr(args, "scale", 1.0);
     const norm2tex::TexturedMesh mesh = [&] {
       const norm2tex::cli::QuietStderr quiet_importer;
-      return norm2tex::TexturedMesh::load(*mesh_path, load_options);
+      return norm2tex::TexturedMesh::load(args["mesh"].as<std::string>(), load_options);
     }();
-    const int padding = args.integer("--padding", 4);
+    const int padding = valueOr(args, "padding", 4);
     if (mesh.hasUvs()) {
       // The atlas the nodes generate for this mesh (materialAtlasSize), unless --size says.
       norm2tex::MaterialConfig for_mesh = config;
       for_mesh.mm_per_texel = mm_per_texel;
       const int atlas_size =
-          args.has("--size") ? size : norm2tex::materialAtlasSize(for_mesh, mesh);
+          args.count("size") ? size : norm2tex::materialAtlasSize(for_mesh, mesh);
       texture = norm2tex::renderMaterialTexture(
           *material, norm2tex::computeUvLayout(mesh, cv::Size(atlas_size, atlas_size)), depth,
           padding);
@@ -256,8 +283,8 @@ int run(int argc, char** argv) {
       unwrap.texture_size = size;
       unwrap.padding_texels = padding;
       const norm2tex::UnwrapResult unwrapped = norm2tex::unwrapUvs(mesh, unwrap);
-      const std::string out_mesh = args.value(
-          "--out-mesh",
+      const std::string out_mesh = valueOr(
+          args, "out-mesh",
           (fs::path(output).parent_path() / (fs::path(output).stem().string() + "_mesh.obj"))
               .string());
       norm2tex::saveMesh(unwrapped.mesh, out_mesh, fs::absolute(output).string());
@@ -278,9 +305,12 @@ int run(int argc, char** argv) {
     mesh_note = note;
   }
   norm2tex::writeImage(output, texture.normal_map);
-  if (const auto albedo = args.value("--albedo")) norm2tex::writeImage(*albedo, texture.albedo);
-  if (const auto height = args.value("--height-out"))
-    norm2tex::writeImage(*height, texture.height_mm);
+  if (args.count("albedo")) {
+    norm2tex::writeImage(args["albedo"].as<std::string>(), texture.albedo);
+  }
+  if (args.count("height-out")) {
+    norm2tex::writeImage(args["height-out"].as<std::string>(), texture.height_mm);
+  }
   std::printf("%s: %s, seed %llu, %dx%d, %d-bit%s, %.2f s\n", output.c_str(), config.name.c_str(),
               static_cast<unsigned long long>(seed), texture.normal_map.cols,
               texture.normal_map.rows, bits, mesh_note.c_str(),
@@ -291,5 +321,6 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  return norm2tex::cli::runMain("norm2tex_texgen", kUsage, run, argc, argv);
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }

@@ -30,7 +30,8 @@ FIXTURES = os.path.join(REPO, "test", "fixtures", "rosdep")
 PLATFORMS = [("ubuntu", "focal"), ("debian", "bullseye"), ("debian", "bookworm"), ("debian", "trixie")]
 
 # Keys the Debian list need not name, with why: rosdep's boost is libboost-all-dev, while the code
-# only includes boost/make_shared.hpp (roscpp's message pointers), which libroscpp-dev brings.
+# needs only boost/make_shared.hpp (roscpp's message pointers), which libroscpp-dev brings, and
+# Boost.Program_options, which has a key of its own (libboost-program-options-dev).
 NOT_LISTED_FOR_DEBIAN = {"boost"}
 
 

@@ -23,11 +23,12 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "cli_arguments.hpp"
 
 namespace {
 
@@ -158,18 +159,22 @@ void afterSleep(int frames, bool paced, std::vector<double>& arithmetic,
   worker.join();
 }
 
-}  // namespace
+norm2tex::cli::Program makeProgram() {
+  norm2tex::cli::Program program(
+      "norm2tex_wake_bench", "norm2tex_wake_bench [FRAMES]",
+      "Measures this machine's floor under a real-time frame, without ROS or rendering, at\n"
+      "FRAMES ticks of 60 Hz (at least 10, default 1200), as p50 / p90 / p99 / max: how late a\n"
+      "thread sleeping to a tick wakes, a hand-over through a pipe to a thread in epoll_wait on\n"
+      "the same CPU and on another, and what a sleep costs the work after it (a 4 MiB memory\n"
+      "pass and an arithmetic loop, back to back and right after sleeping to a tick).");
+  program.positional("FRAMES", 1, norm2tex::cli::po::value<int>());
+  return program;
+}
 
-int main(int argc, char** argv) {
-  const char* const usage = "usage: norm2tex_wake_bench [FRAMES >= 10]\n";
-  if (argc > 1 && (std::strcmp(argv[1], "-h") == 0 || std::strcmp(argv[1], "--help") == 0)) {
-    std::fputs(usage, stdout);
-    return 0;
-  }
-  const int frames = argc > 1 ? std::atoi(argv[1]) : 1200;
-  if (frames < 10 || argc > 2) {
-    std::fputs(usage, stderr);
-    return 2;
+int run(const norm2tex::cli::Program& program, int argc, char** argv) {
+  const int frames = norm2tex::cli::valueOr(program.parse(argc, argv), "FRAMES", 1200);
+  if (frames < 10) {
+    throw norm2tex::cli::UsageError("FRAMES must be at least 10, got " + std::to_string(frames));
   }
   const unsigned cpus = std::thread::hardware_concurrency();
   std::printf("wake-ups at 60 Hz, %d frames each, %u CPUs:\n", frames, cpus);
@@ -184,4 +189,11 @@ int main(int argc, char** argv) {
   report("4 MiB memory pass, back to back", memory_loop);
   report("4 MiB memory pass, after sleeping to a tick", memory_paced);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const norm2tex::cli::Program program = makeProgram();
+  return program.main(argc, argv, [&](int argc, char** argv) { return run(program, argc, argv); });
 }
