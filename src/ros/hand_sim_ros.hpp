@@ -18,6 +18,7 @@
 #include "lock_step.hpp"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/HandReset.h"
+#include "norm2tex/HandState.h"
 #include "norm2tex/HandStep.h"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/hand_sim.hpp"
@@ -71,6 +72,8 @@ class HandSimRos {
   bool onReset(HandReset::Request& request, HandReset::Response& response);
   bool onStep(HandStep::Request& request, HandStep::Response& response);
   void warnClamped(const std::vector<std::string>& clamped);
+  /// What the ~reset and ~step responses say of the hand at the current frame.
+  HandState state() const;
   void runClock();
   void publishStaticTransforms();
   /// The episode's labels on /episode (latched), at start and at every ~reset: what a recording
