@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include <rosgraph_msgs/Clock.h>
+#include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include "conversions.hpp"
@@ -326,9 +327,9 @@ bool HandSimRos::onReset(HandReset::Request& request, HandReset::Response& respo
     std::optional<Eigen::Isometry3d> pose;
     if (request.set_object_pose) pose = fromPoseMsg(request.object_pose, "object_pose");
     sim_->reset(pose ? &*pose : nullptr);
-    // A reset is a frame of its own on the physics clock (one frame of ticks), so stamps keep
-    // increasing and the frame shows the object at rest where it was put.
-    sim_->step(ticks_per_frame_);
+    // The reset's frame shows the state the reset made (the object at rest where it was put),
+    // as TactileHand::reset's does, so both give the same episodes; it has a stamp of its own so
+    // that stamps keep increasing.
     ++frame_;
     opening_command_ = 1.0;
     publishEpisode();
@@ -343,6 +344,7 @@ bool HandSimRos::onReset(HandReset::Request& request, HandReset::Response& respo
   response.success = true;
   response.stamp = frameStamp();
   response.frame = static_cast<std::uint64_t>(frame_);
+  response.state = state();
   return true;
 }
 
@@ -354,6 +356,15 @@ bool HandSimRos::onStep(HandStep::Request& request, HandStep::Response& response
         "~step frames = " + std::to_string(request.frames) + " refused; valid: [1, 100000]";
     ROS_WARN("hand_sim: %s", response.message.c_str());
     return true;
+  }
+  if (!request.targets.name.empty()) {
+    try {
+      warnClamped(sim_->setJointTargets(request.targets.name, request.targets.position));
+    } catch (const Error& e) {
+      response.message = std::string("~step refused, nothing changed: ") + e.what();
+      ROS_WARN("hand_sim: %s", response.message.c_str());
+      return true;
+    }
   }
   response.missing_images = 0;
   try {
@@ -371,15 +382,32 @@ bool HandSimRos::onStep(HandStep::Request& request, HandStep::Response& response
   response.success = true;
   response.stamp = frameStamp();
   response.frame = static_cast<std::uint64_t>(frame_);
-  for (int s = 0; s < sim_->sensorCount(); ++s) {
-    const GelContactState& state = sim_->contact(s);
-    response.sensors.push_back(sim_->sensor(s).name);
-    response.in_contact.push_back(state.in_contact);
-    response.normal_force.push_back(state.normal_force_n);
-    response.penetration.push_back(state.penetration_m);
-    response.too_deep.push_back(state.too_deep);
-  }
+  response.state = state();
   return true;
+}
+
+HandState HandSimRos::state() const {
+  HandState out;
+  for (int s = 0; s < sim_->sensorCount(); ++s) {
+    const GelContactState& contact = sim_->contact(s);
+    out.sensors.push_back(sim_->sensor(s).name);
+    out.in_contact.push_back(contact.in_contact);
+    out.normal_force.push_back(contact.normal_force_n);
+    geometry_msgs::Vector3 shear;
+    tf2::toMsg(contact.shear_force_n, shear);
+    out.shear_force.push_back(shear);
+    out.penetration.push_back(contact.penetration_m);
+    out.too_deep.push_back(contact.too_deep);
+    out.object_in_gel.push_back(tf2::toMsg(contact.object_in_gel));
+  }
+  out.joints = sim_->actuatedJoints();
+  for (const std::string& name : out.joints) {
+    const int j = sim_->description().jointIndex(name);
+    out.joint_positions.push_back(sim_->jointPositions()[j]);
+    out.joint_targets.push_back(sim_->jointTargets()[j]);
+  }
+  out.object_in_world = tf2::toMsg(sim_->objectInWorld());
+  return out;
 }
 
 void HandSimRos::onTick(const ros::WallTime& scheduled) {

@@ -18,6 +18,7 @@
 #include "lock_step.hpp"
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/HandReset.h"
+#include "norm2tex/HandState.h"
 #include "norm2tex/HandStep.h"
 #include "norm2tex/sim/contact_patch.hpp"
 #include "norm2tex/sim/hand_sim.hpp"
@@ -60,6 +61,8 @@ class HandSimRos {
   bool onReset(HandReset::Request& request, HandReset::Response& response);
   bool onStep(HandStep::Request& request, HandStep::Response& response);
   void warnClamped(const std::vector<std::string>& clamped);
+  /// What the ~reset and ~step responses say of the hand at the current frame.
+  HandState state() const;
   /// Real time: a frame period's tick of the clock (WallClockGrid).
   void onTick(const ros::WallTime& scheduled);
   void publishStaticTransforms();

@@ -4,9 +4,11 @@ the launch, its nodes and master included (they run in the launch's own process 
 Not a test module (pytest collects test_*.py only); the tests import it from this folder.
 """
 
+import contextlib
 import os
 import signal
 import subprocess
+import tempfile
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 
@@ -36,3 +38,33 @@ def stop(launch, timeout_s=30):
             os.killpg(launch.pid, signal.SIGKILL)
             launch.communicate()
     return launch.returncode
+
+
+@contextlib.contextmanager
+def system(args, prefix):
+    """`roslaunch -p PORT args...` on a master of its own (a free port, ROS_HOME in a new
+    temporary folder named with `prefix`), with this process's ROS environment pointed at it.
+    Yields (launch, log: its output, an open file); stops it after."""
+    home = tempfile.mkdtemp(prefix=prefix)
+    port = free_port()
+    uri = "http://localhost:%d" % port
+    env = dict(os.environ, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost",
+               ROS_HOME=os.path.join(home, "ros_home"))
+    with open(os.path.join(home, "roslaunch.log"), "w+") as log:
+        launch = start(["-p", str(port)] + list(args), env, log)
+        os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
+        try:
+            yield launch, log
+        finally:
+            stop(launch, timeout_s=20)
+
+
+def joined(make, log):
+    """make() (a backend joining the launch); when it raises, the launch's output last printed
+    first: why the system is not there."""
+    try:
+        return make()
+    except Exception:
+        log.seek(0)
+        print(log.read()[-4000:])
+        raise

@@ -140,7 +140,8 @@ def test_reset_with_the_same_seed_gives_the_same_observations():
             np.testing.assert_array_equal(x[k], y[k], err_msg=k)
     # The object is back at its pose after a reset, whatever the episode before did.
     env.reset(seed=5)
-    np.testing.assert_allclose(env.hand.sim.object_in_world()[:3, 3], CUBE_ON_FLOOR, atol=1e-9)
+    np.testing.assert_allclose(env.backend.state()["object_in_world"][:3, 3], CUBE_ON_FLOOR,
+                               atol=1e-9)
 
 
 def test_noise_follows_the_seed(tmp_path):
@@ -154,7 +155,8 @@ def test_noise_follows_the_seed(tmp_path):
     np.testing.assert_array_equal(a, b)
     assert not np.array_equal(a, c)
     off = wsg_env(sensor=sensor, noise=False)
-    np.testing.assert_array_equal(off.reset(seed=3)[0]["digit_left"], off.hand.background(0))
+    np.testing.assert_array_equal(off.reset(seed=3)[0]["digit_left"],
+                                  off.backend.background("digit_left"))
 
 
 def test_closing_the_wsg_changes_both_images_where_it_presses():
@@ -192,25 +194,33 @@ def test_delta_actions_move_from_the_joint_positions():
     np.testing.assert_allclose(obs["joint_positions"], [-0.031, 0.036], atol=1e-6)
 
 
-def test_bad_actions_are_refused_with_a_clear_error():
-    env = wsg_env()
+def check_bad_actions_are_refused(env):
+    """A WSG-50 HandEnv (either backend) refuses bad actions with the reason, nothing moved, and
+    clips out-of-range ones, naming them (test_hand_ros_backend.py uses it too)."""
     env.reset(seed=0)
-    before = env.hand.sim.joint_targets().copy()
-    with pytest.raises(ValueError, match=r"shape \(3,\); valid: \(2,\)"):
+    before = env.backend.state()
+    with pytest.raises(ValueError, match=r"action of shape \(3,\); valid: \(2,\)"):
         env.step(np.zeros(3, np.float32))
-    with pytest.raises(ValueError, match="base_joint_gripper_right is not finite"):
+    with pytest.raises(ValueError, match="action for base_joint_gripper_right is not finite"):
         env.step(np.array([-0.02, np.nan], np.float32))
     with pytest.raises(ValueError, match="not numbers"):
         env.step(["close", "open"])
-    np.testing.assert_array_equal(env.hand.sim.joint_targets(), before)
+    after = env.backend.state()
+    np.testing.assert_array_equal(after["joint_targets"], before["joint_targets"])
+    assert after["frame"] == before["frame"]
     # Out of the Box: clipped to the limits, named.
     obs, _, _, _, info = env.step(np.array([-1.0, 0.03], np.float32))
     assert info["clipped"] == ["base_joint_gripper_left"]
     np.testing.assert_allclose(info["joint_targets"], [-0.055, 0.03], rtol=1e-6)
+
+
+def test_bad_actions_are_refused_with_a_clear_error():
+    env = wsg_env()
+    check_bad_actions_are_refused(env)
     with pytest.raises(ValueError, match="action = 'velocity'; valid: position, delta"):
         wsg_env(action="velocity")
-    with pytest.raises(ValueError, match="backend = 'ros'"):
-        wsg_env(backend="ros")
+    with pytest.raises(ValueError, match="backend = 'gazebo'; valid: inprocess, ros"):
+        wsg_env(backend="gazebo")
     with pytest.raises(ValueError, match="reset options"):
         env.reset(options={"height": 1})
 

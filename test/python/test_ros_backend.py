@@ -41,22 +41,11 @@ def sensor_yaml():
 @pytest.fixture(scope="module")
 def ros_system(sensor_yaml):
     """gripper_sim.launch mode:=synchronous on a master of its own; this process's rospy on it."""
-    home = tempfile.mkdtemp(prefix="norm2tex_ros_backend_test_")
-    port = ros_launch.free_port()
-    uri = "http://localhost:%d" % port
-    env = dict(os.environ, ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost",
-               ROS_HOME=os.path.join(home, "ros_home"))
-    log = open(os.path.join(home, "roslaunch.log"), "w+")
-    launch = ros_launch.start(
-        ["-p", str(port), "norm2tex", "gripper_sim.launch", "mode:=synchronous", "noise_seed:=-1",
-         "texture_from_frame:=true", "seed:=%d" % LAUNCH_SEED, "sensor:=" + sensor_yaml],
-        env, log)
-    os.environ.update(ROS_MASTER_URI=uri, ROS_HOSTNAME="localhost")
-    try:
-        yield launch, log
-    finally:
-        ros_launch.stop(launch, timeout_s=20)
-        log.close()
+    with ros_launch.system(
+            ["norm2tex", "gripper_sim.launch", "mode:=synchronous", "noise_seed:=-1",
+             "texture_from_frame:=true", "seed:=%d" % LAUNCH_SEED, "sensor:=" + sensor_yaml],
+            "norm2tex_ros_backend_test_") as system:
+        yield system
 
 
 @pytest.fixture(scope="module")
@@ -64,13 +53,7 @@ def backends(ros_system, sensor_yaml):
     from norm2tex.envs.inprocess_backend import InProcessBackend
     from norm2tex.envs.ros_backend import RosBackend
 
-    launch, log = ros_system
-    try:
-        ros = RosBackend(service_timeout_s=40.0, depth=True)
-    except Exception:
-        log.seek(0)
-        print(log.read()[-4000:])
-        raise
+    ros = ros_launch.joined(lambda: RosBackend(service_timeout_s=40.0, depth=True), ros_system[1])
     inproc = InProcessBackend(seed=LAUNCH_SEED, noise_seed=None, noise_per_episode=False,
                               sensor=sensor_yaml)
     yield ros, inproc

@@ -170,8 +170,8 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
       [&] { return hand.images["digit_left"] >= 30 && hand.images["digit_right"] >= 30; }, 10.0));
   EXPECT_EQ(hand.images["digit_left"], 30);
   EXPECT_EQ(hand.images["digit_right"], 30);
-  ASSERT_EQ(first.sensors, (std::vector<std::string>{"digit_left", "digit_right"}));
-  EXPECT_FALSE(first.in_contact[0] || first.in_contact[1]);
+  ASSERT_EQ(first.state.sensors, (std::vector<std::string>{"digit_left", "digit_right"}));
+  EXPECT_FALSE(first.state.in_contact[0] || first.state.in_contact[1]);
   EXPECT_TRUE(hand.buffer.canTransform("world", "digit_left_gel", first.stamp, ros::Duration(5.0)));
   EXPECT_TRUE(hand.buffer.canTransform("finger_right_tip", "digit_right_gel", ros::Time(0),
                                        ros::Duration(5.0)));
@@ -181,28 +181,28 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   // Close both fingers past the cube within 2 s: each drive stops at its 10 N effort.
   hand.send(closing(-0.016, 0.016, 2.0));
   const auto held = hand.stepFrames(150);
-  EXPECT_TRUE(held.in_contact[0] && held.in_contact[1]);
-  EXPECT_NEAR(held.normal_force[0], 10.0, 0.5);
-  EXPECT_NEAR(held.normal_force[1], 10.0, 0.5);
-  EXPECT_GT(held.penetration[0], 0.5e-3);
+  EXPECT_TRUE(held.state.in_contact[0] && held.state.in_contact[1]);
+  EXPECT_NEAR(held.state.normal_force[0], 10.0, 0.5);
+  EXPECT_NEAR(held.state.normal_force[1], 10.0, 0.5);
+  EXPECT_GT(held.state.penetration[0], 0.5e-3);
   ASSERT_TRUE(waitFor(
       [&] { return hand.images["digit_left"] == 180 && hand.images["digit_right"] == 180; }, 10.0));
   // The gel frame sees the cube's face at the indentation the physics reports.
   const geometry_msgs::TransformStamped cube =
       hand.buffer.lookupTransform("digit_left_gel", "object", held.stamp, ros::Duration(5.0));
-  EXPECT_NEAR(cube.transform.translation.z, 0.015 - held.penetration[0], 0.2e-3);
+  EXPECT_NEAR(cube.transform.translation.z, 0.015 - held.state.penetration[0], 0.2e-3);
 
   // Refused with the reason and nothing changed: an unknown joint; then a reset opens the hand.
   trajectory_msgs::JointTrajectory wrong = closing(-0.05, 0.05, 0.5);
   wrong.joint_names[1] = "thumb";
   hand.send(wrong);
   const auto still = hand.stepFrames(30);
-  EXPECT_NEAR(still.normal_force[0], 10.0, 0.5);
+  EXPECT_NEAR(still.state.normal_force[0], 10.0, 0.5);
   norm2tex::HandReset reset;
   ASSERT_TRUE(hand.reset.call(reset));
   EXPECT_TRUE(reset.response.success) << reset.response.message;
   const auto open = hand.stepFrames(1);
-  EXPECT_FALSE(open.in_contact[0] || open.in_contact[1]);
+  EXPECT_FALSE(open.state.in_contact[0] || open.state.in_contact[1]);
   // The parallel GripperCommand of a two-finger hand closes it; ~base_pose streamed a pose per
   // frame lifts it, and the cube with it.
   ros::Publisher gripper = hand.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 1);
@@ -216,7 +216,7 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   // The command is taken before the next ~step: hand_sim handles it as it arrives.
   ASSERT_TRUE(waitFor(
       [&] {
-        return hand.stepFrames(1).in_contact == std::vector<std::uint8_t>{1, 1};
+        return hand.stepFrames(1).state.in_contact == std::vector<std::uint8_t>{1, 1};
       },
       30.0));
   hand.stepFrames(60);
@@ -232,7 +232,7 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
     hand.stepFrames(1);
   }
   const auto lifted = hand.stepFrames(10);
-  EXPECT_TRUE(lifted.in_contact[0] && lifted.in_contact[1]);
+  EXPECT_TRUE(lifted.state.in_contact[0] && lifted.state.in_contact[1]);
   const geometry_msgs::TransformStamped cube_in_world =
       hand.buffer.lookupTransform("world", "object", lifted.stamp, ros::Duration(5.0));
   EXPECT_GT(cube_in_world.transform.translation.z, 0.015 + 0.02) << published << " poses sent";
@@ -277,7 +277,7 @@ TEST(HandSimTexture, ANormalMapWithoutMaterialTexturesTheGraspAndLabelsTheEpisod
   };
   // Open, nothing touches: the texture is not drawn (the same background and noise seed).
   const auto open = hand.stepFrames(1);
-  ASSERT_FALSE(open.in_contact[0]);
+  ASSERT_FALSE(open.state.in_contact[0]);
   const cv::Mat untouched = difference(open.stamp);
   ASSERT_FALSE(untouched.empty());
   EXPECT_EQ(cv::countNonZero(untouched), 0);
@@ -285,7 +285,7 @@ TEST(HandSimTexture, ANormalMapWithoutMaterialTexturesTheGraspAndLabelsTheEpisod
   // Held at the drives' 10 N: the cube's face presses the middle of the gel, and its relief shows.
   hand.send(closing(-0.016, 0.016, 1.0));
   const auto held = hand.stepFrames(90);
-  ASSERT_TRUE(held.in_contact[0]);
+  ASSERT_TRUE(held.state.in_contact[0]);
   const cv::Mat touched = difference(held.stamp);
   ASSERT_FALSE(touched.empty());
   const cv::Rect middle(touched.cols / 4, touched.rows / 4, touched.cols / 2, touched.rows / 2);

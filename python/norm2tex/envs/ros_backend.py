@@ -28,12 +28,10 @@ It has InProcessBackend's interface for count 1 (see its docstring; ``step_one(0
     ``seed:=``, already ran when contact_sim started, as InProcessBackend's construction does).
 """
 
-import threading
-import time
-
 import numpy as np
 
 import norm2tex
+from norm2tex.envs.ros_client import RosClient, bgr8, frame_seconds
 
 # Command modes of a backend step (as InProcessBackend's).
 KEEP, ABSOLUTE, DELTA = 0, 1, 2
@@ -41,7 +39,7 @@ KEEP, ABSOLUTE, DELTA = 0, 1, 2
 FINGERS = ("left", "right")
 
 
-class RosBackend:
+class RosBackend(RosClient):
     """One gripper of a running ``gripper_sim.launch mode:=synchronous`` (see the module's doc).
 
     namespace: the launch's ``ns`` ("/" by default).
@@ -52,54 +50,22 @@ class RosBackend:
     Raises norm2tex.Error (a RuntimeError) with what to start when the system is not there.
     """
 
-    START = "start: roslaunch norm2tex gripper_sim.launch mode:=synchronous texture_from_frame:=true"
-
     def __init__(self, namespace="/", service_timeout_s=30.0, frame_timeout_s=10.0, depth=False,
                  node_name="norm2tex_ros_backend"):
-        import rosgraph
-        import rospy
         from norm2tex.msg import GripperCommand
         from norm2tex.srv import Reset, Step
-        from sensor_msgs.msg import Image
 
-        self._rospy = rospy
+        super().__init__("RosBackend", "contact_sim", "gripper_sim.launch",
+                         "start: roslaunch norm2tex gripper_sim.launch mode:=synchronous "
+                         "texture_from_frame:=true", namespace, service_timeout_s,
+                         frame_timeout_s, node_name)
         self._GripperCommand = GripperCommand
         self._Reset, self._Step = Reset, Step
-        self.frame_timeout_s = float(frame_timeout_s)
-        ns = "/" + namespace.strip("/") + "/" if namespace.strip("/") else "/"
-        self._ns = ns
-        deadline = time.monotonic() + float(service_timeout_s)
-
-        while not rosgraph.is_master_online():
-            if time.monotonic() > deadline:
-                raise norm2tex.Error("RosBackend: no ROS master at %s within %.0f s; %s"
-                                     % (rosgraph.get_master_uri(), service_timeout_s, self.START))
-            time.sleep(0.1)
-        if not rospy.core.is_initialized():
-            rospy.init_node(node_name, anonymous=True, disable_signals=True)
-
-        self._step_name, self._reset_name = ns + "contact_sim/step", ns + "contact_sim/reset"
-        for name in (self._reset_name, self._step_name):
-            remaining = deadline - time.monotonic()
-            try:
-                rospy.wait_for_service(name, timeout=max(remaining, 0.01))
-            except rospy.ROSException:
-                mode = rospy.get_param(ns + "contact_sim/mode", None)
-                why = (" (contact_sim runs in mode %s: ~step exists only in synchronous mode)"
-                       % mode if mode not in (None, "synchronous") else "")
-                raise norm2tex.Error("RosBackend: service %s did not appear within %.0f s%s; %s"
-                                     % (name, service_timeout_s, why, self.START)) from None
+        self._connect({"reset": Reset, "step": Step})
+        self._check_renderers(["digit_" + f for f in FINGERS])
 
         # The launch's choices, as contact_sim and the renderers read them.
-        param = lambda name, default=None: rospy.get_param(ns + name, default)  # noqa: E731
-        if param("contact_sim/mode") != "synchronous":
-            raise norm2tex.Error("RosBackend: contact_sim runs in mode %r, not synchronous; %s"
-                                 % (param("contact_sim/mode"), self.START))
-        renderers = param("contact_sim/renderers", [])
-        missing = [s for s in ("digit_left", "digit_right") if s not in renderers]
-        if missing:
-            raise norm2tex.Error("RosBackend: contact_sim's ~renderers %s lacks %s: its ~step would "
-                                 "not wait for their images" % (renderers, missing))
+        param = self.param
         self.material = param("contact_sim/material", "wood") or "none"
         self.scene = param("contact_sim/scene", "")
         self.mesh = param("contact_sim/mesh", "")
@@ -113,76 +79,30 @@ class RosBackend:
         self.friction = friction if friction >= 0 else (material.friction if material else 0.5)
         beta = float(param("digit_left_renderer/beta", -1.0))
         self.beta_mm = beta if beta >= 0 else (material.beta_mm if material else 0.0)
-        noise = int(param("digit_left_renderer/noise_seed", 0))
-        self.noise_seed = None if noise < 0 else noise
+        self._read_noise_seed("digit_left_renderer")
         self.texture_from_frame = bool(param("digit_left_renderer/texture_from_frame", False))
-        frame_rate = float(param("contact_sim/frame_rate", 60.0))
-        physics_rate = float(param("contact_sim/physics_rate", 1000.0))
-        ticks = max(1, int(round(physics_rate / frame_rate)))  # contact_sim's whole ticks a frame
-        self.frame_seconds = ticks * (1.0 / (ticks * frame_rate))
+        self.frame_seconds = frame_seconds(float(param("contact_sim/frame_rate", 60.0)),
+                                           float(param("contact_sim/physics_rate", 1000.0)))
         low, high = param("contact_sim/height_offset_range", [float("nan")] * 2)
         self.height_offset_range = (float(low), float(high))
         self.size = 1
         self.has_material = material is not None
-        # The renderers count noise frames from the launch; the seed is the launch's.
-        self.noise_per_episode = False
 
-        self._step_proxy = rospy.ServiceProxy(self._step_name, Step, persistent=True)
-        self._reset_proxy = rospy.ServiceProxy(self._reset_name, Reset, persistent=True)
-
-        # The latest message of each topic; waiters wake on every arrival.
-        self._cond = threading.Condition()
-        self._latest = {}
-        self._subscribers = []
         kinds = ("image_raw", "depth") if depth else ("image_raw",)
-        for finger in FINGERS:
-            for kind in kinds + ("background",):
-                topic = "%sdigit_%s/%s" % (ns, finger, kind)
-                self._subscribers.append(rospy.Subscriber(
-                    topic, Image, self._receive, callback_args=(finger, kind), queue_size=None,
-                    buff_size=1 << 24, tcp_nodelay=True))
-        # Frames published before a subscription is connected are not delivered: connect first.
-        for sub in self._subscribers:
-            while sub.get_num_connections() < 1:
-                if time.monotonic() > deadline:
-                    raise norm2tex.Error("RosBackend: %s has no publisher within %.0f s; are the "
-                                         "renderers of this launch running?"
-                                         % (sub.name, service_timeout_s))
-                time.sleep(0.01)
+        self._subscribe([self._topic(f, k) for f in FINGERS for k in kinds + ("background",)])
         self._depth = bool(depth)
         self._stamp = None  # the frame the backend is at (after a reset or step)
         self._state = None
         self._backgrounds = {}
 
-    # --- messages -------------------------------------------------------------------------------
-    def _receive(self, msg, key):
-        with self._cond:
-            self._latest[key] = msg
-            self._cond.notify_all()
-
-    def _wait_for(self, keys, stamp, what):
-        """Until every key's latest message has `stamp` (rospy.Time) or is latched (stamp None)."""
-        deadline = time.monotonic() + self.frame_timeout_s
-        with self._cond:
-            while True:
-                msgs = [self._latest.get(k) for k in keys]
-                if all(m is not None and (stamp is None or m.header.stamp == stamp) for m in msgs):
-                    return msgs
-                remaining = deadline - time.monotonic()
-                if remaining <= 0:
-                    seen = ["%s/%s: %s" % (k[0], k[1], "none" if m is None else m.header.stamp)
-                            for k, m in zip(keys, msgs)]
-                    raise norm2tex.Error(
-                        "RosBackend: %s of %s not received within frame_timeout_s = %.1f s (latest: "
-                        "%s); are the renderers digit_left/digit_right of this launch running?"
-                        % (what, "the latched message" if stamp is None else "stamp %s" % stamp,
-                           self.frame_timeout_s, ", ".join(seen)))
-                self._cond.wait(remaining)
+    def _topic(self, finger, kind):
+        return self.topic("digit_%s/%s" % (finger, kind))
 
     def _frame_msg(self, finger, kind):
         if self._stamp is None:
-            raise norm2tex.Error("RosBackend: no frame yet; call reset() first")
-        return self._wait_for([(finger, kind)], self._stamp, "/digit_%s/%s" % (finger, kind))[0]
+            raise self.error("no frame yet; call reset() first")
+        return self._wait_for([self._topic(finger, kind)], self._stamp,
+                              "/digit_%s/%s" % (finger, kind))[0]
 
     @staticmethod
     def _check_finger(finger):
@@ -190,19 +110,6 @@ class RosBackend:
             raise ValueError("finger %r; valid: 'left', 'right'" % (finger,))
 
     # --- the backend interface ------------------------------------------------------------------
-    def _call(self, proxy_attr, name, service, request):
-        try:
-            return getattr(self, proxy_attr)(request)
-        except (self._rospy.ServiceException, OSError):
-            # A persistent connection that broke (contact_sim restarted): one new try.
-            proxy = self._rospy.ServiceProxy(name, service, persistent=True)
-            setattr(self, proxy_attr, proxy)
-            try:
-                return proxy(request)
-            except (self._rospy.ServiceException, OSError) as error:
-                raise norm2tex.Error("RosBackend: %s failed: %s; is gripper_sim.launch still "
-                                     "running?" % (name, error)) from None
-
     def _take_state(self, r, commanded):
         self._state = {
             "opening": np.array([r.opening], dtype=np.float64),
@@ -231,9 +138,8 @@ class RosBackend:
             variant = None  # no texture to vary
         if variant is not None and int(variant) != self.variant:
             if not self.texture_from_frame:
-                raise norm2tex.Error(
-                    "RosBackend: variant %d asked, but the renderers draw only the launch's variant "
-                    "%d; %s" % (int(variant), self.variant, self.START))
+                raise self.error("variant %d asked, but the renderers draw only the launch's "
+                                 "variant %d; %s" % (int(variant), self.variant, self.START))
             request.set_texture = True
             request.variant = int(variant)
         if self.has_material and self.texture_from_frame and next_variant is not None:
@@ -242,7 +148,7 @@ class RosBackend:
             request.variant = self.variant if variant is None else int(variant)
             request.next_material = self.material
             request.next_variant = int(next_variant)
-        r = self._call("_reset_proxy", self._reset_name, self._Reset, request)
+        r = self._call("reset", request)
         if not r.success:
             raise norm2tex.Error(r.message)
         if request.set_texture:
@@ -257,12 +163,7 @@ class RosBackend:
         """The renderers' noise seed is fixed at launch (noise_seed:=, negative = None): only that
         one is accepted."""
         self._check_index(i)
-        wanted = None if noise_seed is None or int(noise_seed) < 0 else int(noise_seed)
-        if wanted != self.noise_seed:
-            raise norm2tex.Error(
-                "RosBackend: noise seed %s asked, but the renderers were launched with %s; "
-                "relaunch with noise_seed:=%s" % (wanted, self.noise_seed,
-                                                  -1 if wanted is None else wanted))
+        self._check_noise_seed(noise_seed)
 
     def prefetch_variant(self, variant):
         """Nothing here: reset(..., next_variant=v) announces it to the renderers."""
@@ -272,8 +173,7 @@ class RosBackend:
         (~step); returns once both images of the last frame are here. Raises norm2tex.Error
         with contact_sim's message when it refuses (nothing moved) or a frame failed."""
         if len(modes) != 1 or len(values) != 1:
-            raise norm2tex.Error("RosBackend: %d modes and %d values for 1 gripper"
-                                 % (len(modes), len(values)))
+            raise self.error("%d modes and %d values for 1 gripper" % (len(modes), len(values)))
         mode, value = int(modes[0]), float(values[0])
         request = self._Step._request_class()
         request.frames = int(frames)
@@ -284,15 +184,15 @@ class RosBackend:
             request.command.opening = value
         elif mode != KEEP:
             raise ValueError("command mode %d; valid: 0 keep, 1 absolute, 2 delta" % mode)
-        r = self._call("_step_proxy", self._step_name, self._Step, request)
+        r = self._call("step", request)
         if not r.success:
             raise norm2tex.Error(r.message)
         if r.missing_images:
-            raise norm2tex.Error("RosBackend: %d images of this step were not rendered (see the "
-                                 "renderers' log)" % r.missing_images)
+            raise self.error("%d images of this step were not rendered (see the renderers' log)"
+                             % r.missing_images)
         self._stamp = r.stamp
         self._take_state(r, r.commanded_opening)
-        self._wait_for([(f, "image_raw") for f in FINGERS], self._stamp, "images")
+        self._wait_for([self._topic(f, "image_raw") for f in FINGERS], self._stamp, "images")
 
     def step_one(self, i, mode, value, frames=1):
         """Gripper i alone: with one gripper, step()."""
@@ -302,19 +202,14 @@ class RosBackend:
     def images(self, finger):
         """(1, 320, 240, 3) uint8 bgr8: the sensor's image of the current frame."""
         self._check_finger(finger)
-        msg = self._frame_msg(finger, "image_raw")
-        if msg.encoding != "bgr8":
-            raise norm2tex.Error("RosBackend: /digit_%s/image_raw is %s, not bgr8"
-                                 % (finger, msg.encoding))
-        image = np.frombuffer(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
-        return image[:, : msg.width * 3].reshape(1, msg.height, msg.width, 3).copy()
+        return bgr8(self._frame_msg(finger, "image_raw"), "/digit_%s/image_raw" % finger)[None]
 
     def depths(self, finger):
         """(1, 320, 240) float32 gel deformation [m] of the current frame (needs depth=True)."""
         self._check_finger(finger)
         if not self._depth:
-            raise norm2tex.Error("RosBackend: depths need RosBackend(depth=True) (the renderers "
-                                 "publish depth only to subscribers)")
+            raise self.error("depths need RosBackend(depth=True) (the renderers publish depth "
+                             "only to subscribers)")
         msg = self._frame_msg(finger, "depth")
         dtype = np.dtype(np.float32).newbyteorder(">" if msg.is_bigendian else "<")
         rows = np.frombuffer(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
@@ -325,26 +220,15 @@ class RosBackend:
         """(320, 240, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""
         self._check_finger(finger)
         if finger not in self._backgrounds:
-            msg = self._wait_for([(finger, "background")], None, "/digit_%s/background" % finger)[0]
-            image = np.frombuffer(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
-            self._backgrounds[finger] = image[:, : msg.width * 3].reshape(
-                msg.height, msg.width, 3).copy()
+            topic = self._topic(finger, "background")
+            self._backgrounds[finger] = bgr8(self._wait_for([topic], None, topic)[0], topic)
         return self._backgrounds[finger]
 
     def state(self):
         """As InProcessBackend.state(), at the current frame (from the ~step/~reset response)."""
         if self._state is None:
-            raise norm2tex.Error("RosBackend: no frame yet; call reset() first")
+            raise self.error("no frame yet; call reset() first")
         return {k: v.copy() for k, v in self._state.items()}
-
-    def close(self):
-        """Unsubscribes and closes the service connections (the ROS system keeps running)."""
-        for s in self._subscribers:
-            s.unregister()
-        self._subscribers = []
-        for proxy in (getattr(self, "_step_proxy", None), getattr(self, "_reset_proxy", None)):
-            if proxy is not None:
-                proxy.close()
 
     @staticmethod
     def _check_index(i):
