@@ -302,7 +302,10 @@ void bindHand(py::module& m) {
       .def_readwrite("friction", &TactileHandOptions::friction, "< 0: the material's")
       .def_readwrite("noise_seed", &TactileHandOptions::noise_seed, "< 0: no noise")
       .def_readwrite("noise_per_episode", &TactileHandOptions::noise_per_episode,
-                     "count the noise's frames from each reset (else from construction)");
+                     "count the noise's frames from each reset (else from construction)")
+      .def_readwrite("render_threads", &TactileHandOptions::render_threads,
+                     "threads the sensors render on (the same frames whatever the count): 1 one "
+                     "after another, 0 one per core");
 
   py::class_<TactileHand>(
       m, "TactileHand",

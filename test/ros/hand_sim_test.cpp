@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <string>
 
@@ -25,6 +27,7 @@
 #include "norm2tex/GripperCommand.h"
 #include "norm2tex/HandReset.h"
 #include "norm2tex/HandStep.h"
+#include "dataset_export.hpp"
 #include "wait_for.hpp"
 
 namespace {
@@ -153,6 +156,31 @@ TEST(HandSimRecord, TheRecorderWritesEverySensorsImagesThenLeavesTheHandRunning)
     EXPECT_EQ(topic_stamps[1], stamps[0]) << topic;
     EXPECT_EQ(topic_stamps[3], stamps[1]) << topic;
   }
+
+  // norm2tex_export takes a hand's recording as the gripper's: a row per image, each sensor's.
+  std::vector<std::string> bags;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() == ".bag") bags.push_back(entry.path().string());
+  }
+  std::sort(bags.begin(), bags.end());
+  norm2tex::ExportOptions options;
+  options.out_dir = dir + "/export";
+  const norm2tex::ExportSummary summary = norm2tex::exportDataset(bags, options);
+  EXPECT_EQ(summary.frames, 10u);
+  EXPECT_EQ(summary.frames_per_material.at("wood"), 10u);
+  std::ifstream labels(options.out_dir + "/labels.csv");
+  std::string line;
+  std::getline(labels, line);  // the header: raw,diff,depth,material,variant,sensor,stamp,...
+  std::map<std::string, int> rows_per_sensor;
+  while (std::getline(labels, line)) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
+    ASSERT_GE(fields.size(), 7u) << line;
+    ++rows_per_sensor[fields[5]];
+    EXPECT_TRUE(std::filesystem::exists(options.out_dir + "/" + fields[0])) << line;
+  }
+  EXPECT_EQ(rows_per_sensor, (std::map<std::string, int>{{"digit_left", 5}, {"digit_right", 5}}));
   std::filesystem::remove_all(dir);
 }
 

@@ -28,7 +28,8 @@ class HandInProcessBackend:
     """
 
     def __init__(self, hand, object=None, scale=1.0, object_pose=None, scene=None, sensor=None,
-                 material="wood", variant=0, beta_mm=None, friction=None, noise_seed=0):
+                 material="wood", variant=0, beta_mm=None, friction=None, noise_seed=0,
+                 render_threads=0):
         if scene is not None:
             config = norm2tex.HandSimConfig(
                 hand, norm2tex.SceneConfig.load(norm2tex.scene_config(scene)))
@@ -47,6 +48,9 @@ class HandInProcessBackend:
         options.friction = -1.0 if friction is None else float(friction)
         options.noise_seed = -1 if noise_seed is None else int(noise_seed)
         options.noise_per_episode = True
+        # The sensors render at once, one per core (frames identical to one after another), as
+        # hand_sim.launch's renderers, a nodelet each, do.
+        options.render_threads = int(render_threads)
         sensor_model = norm2tex.SensorModel.load(sensor or norm2tex.config_path("digit.yaml"))
         self.hand = norm2tex.TactileHand(config, sensor_model, options)
         self.material = os.path.splitext(os.path.basename(material))[0] if material else None
