@@ -47,6 +47,7 @@ _CORE_NAMES = (
     "GelLaw",
     "TactileGripperOptions",
     "TactileGripperBatch",
+    "OpeningCommand",
     "SensorMount",
     "HandConfig",
     "HandSimConfig",

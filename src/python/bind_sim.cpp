@@ -69,7 +69,26 @@ py::array stackImages(const TactileGripperBatch& batch, Finger finger) {
 
 }  // namespace
 
+namespace {
+
+/// A command mode from Python (an int or a norm2tex.OpeningCommand); ValueError for others.
+OpeningCommand openingCommand(int mode) {
+  if (mode < 0 || mode > 2) {
+    throw py::value_error("command mode " + std::to_string(mode) +
+                          "; valid: 0 ABSOLUTE, 1 DELTA, 2 KEEP (norm2tex.envs.commands)");
+  }
+  return static_cast<OpeningCommand>(mode);
+}
+
+}  // namespace
+
 void bindSim(py::module& m) {
+  py::enum_<OpeningCommand>(m, "OpeningCommand",
+                            "A command mode of TactileGripperBatch.step (the values of "
+                            "GripperCommand.msg's ABSOLUTE and DELTA, then KEEP)")
+      .value("ABSOLUTE", OpeningCommand::kAbsolute)
+      .value("DELTA", OpeningCommand::kDelta)
+      .value("KEEP", OpeningCommand::kKeep);
   py::class_<GelLaw>(m, "GelLaw",
                      "The gel's force-indentation law (scene yaml gel.law): normal force of a "
                      "contact from its deepest indentation, piecewise power law through points.")
@@ -216,27 +235,22 @@ void bindSim(py::module& m) {
           [](TactileGripperBatch& b, const std::vector<int>& modes, const std::vector<double>& values,
              int frames) {
             std::vector<OpeningCommand> m(modes.size());
-            for (std::size_t i = 0; i < modes.size(); ++i) {
-              if (modes[i] < 0 || modes[i] > 2) {
-                throw py::value_error("command mode " + std::to_string(modes[i]) +
-                                      "; valid: 0 keep, 1 absolute, 2 delta");
-              }
-              m[i] = static_cast<OpeningCommand>(modes[i]);
-            }
+            for (std::size_t i = 0; i < modes.size(); ++i) m[i] = openingCommand(modes[i]);
             py::gil_scoped_release release;
             b.step(m, values, frames);
           },
           py::arg("modes"), py::arg("values"), py::arg("frames") = 1,
-          "Per gripper: mode 0 keeps the command, 1 sets the opening to value, 2 adds value "
-          "(clamped); then every gripper advances `frames` sensor frames and both sensors render. "
+          "Per gripper: mode 0 (ABSOLUTE) sets the opening to value, 1 (DELTA) adds value "
+          "(clamped), 2 (KEEP) keeps the command (norm2tex.envs.commands); then every gripper advances `frames` sensor frames and both sensors render. "
           "An invalid command raises and moves nothing.")
       .def(
           "step_one",
           [](TactileGripperBatch& b, int i, int mode, double value, int frames) {
             TactileGripper& g = b.gripper(i);
+            const OpeningCommand command = openingCommand(mode);
             py::gil_scoped_release release;
-            if (mode == 1) g.sim().setOpening(value);
-            if (mode == 2) g.sim().addOpening(value);
+            if (command == OpeningCommand::kAbsolute) g.sim().setOpening(value);
+            if (command == OpeningCommand::kDelta) g.sim().addOpening(value);
             g.step(frames);
           },
           py::arg("index"), py::arg("mode"), py::arg("value"), py::arg("frames") = 1,

@@ -25,10 +25,17 @@
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/tactile_gripper_batch.hpp"
 #include "params.hpp"
 
 namespace norm2tex {
 namespace {
+
+// One set of command values (norm2tex/envs/commands.py, docs/ros.md "One table"): the core's
+// batch modes are the message's.
+static_assert(static_cast<int>(OpeningCommand::kAbsolute) == GripperCommand::ABSOLUTE &&
+                  static_cast<int>(OpeningCommand::kDelta) == GripperCommand::DELTA,
+              "OpeningCommand and GripperCommand.msg must share their values");
 
 using ros_params::badParameter;
 using ros_params::materialConfigPath;

@@ -272,3 +272,36 @@ def test_block_mean_equals_numpy_bit_for_bit_and_refuses_bad_input():
                 dict(images=images, factor=2, background=background[:60])):
         with pytest.raises(ValueError):
             norm2tex.block_mean(**bad)
+
+
+def test_command_modes_are_one_set_of_values():
+    # norm2tex.envs.commands, the core's OpeningCommand and the message's constants agree, and a
+    # batch step refuses a mode outside them, naming the names.
+    from norm2tex.envs import commands
+
+    assert int(norm2tex.OpeningCommand.ABSOLUTE) == commands.ABSOLUTE
+    assert int(norm2tex.OpeningCommand.DELTA) == commands.DELTA
+    assert int(norm2tex.OpeningCommand.KEEP) == commands.KEEP
+    try:
+        from norm2tex.msg import GripperCommand
+    except ImportError:
+        pytest.skip("the generated messages are not on the path")
+    assert GripperCommand.ABSOLUTE == commands.ABSOLUTE
+    assert GripperCommand.DELTA == commands.DELTA
+    assert len({commands.CLOSE, commands.STAY, commands.OPEN}) == 3
+
+
+def test_a_batch_step_applies_each_mode_as_named(sensor):
+    from norm2tex.envs.commands import ABSOLUTE, DELTA, KEEP
+
+    scene = norm2tex.SceneConfig.load(norm2tex.scene_config("cube"))
+    options = norm2tex.TactileGripperOptions()
+    batch = norm2tex.TactileGripperBatch(scene, sensor, [options] * 3, threads=1)
+    before = [batch.sim(i).commanded_opening for i in range(3)]
+    batch.step([ABSOLUTE, DELTA, KEEP], [0.25, -0.5, 0.9])
+    after = [batch.sim(i).commanded_opening for i in range(3)]
+    assert after[0] == pytest.approx(0.25)
+    assert after[1] == pytest.approx(max(0.0, before[1] - 0.5))
+    assert after[2] == before[2]
+    with pytest.raises(ValueError, match="command mode 3; valid: 0 ABSOLUTE, 1 DELTA, 2 KEEP"):
+        batch.step([3, KEEP, KEEP], [0.0, 0.0, 0.0])

@@ -171,7 +171,7 @@ def test_bad_arguments_are_refused_clearly():
         GripperEnv(material="granite")
     env = GripperEnv(noise=False)
     env.reset(seed=0)
-    with pytest.raises(ValueError, match="0 \\(close\\)"):
+    with pytest.raises(ValueError, match="0 \\(CLOSE\\)"):
         env.step(3)
     with pytest.raises(norm2tex.Error, match="offset"):
         env.reset(seed=0, options={"height_offset_m": 0.5})

@@ -63,9 +63,13 @@ def backends(ros_system, sensor_yaml):
 
 def _commands():
     """~30 steps: the paper's deltas, absolute commands, a multi-frame step, a drop."""
-    c = [(2, -0.005, 1)] * 4 + [(0, 0.0, 1)] * 3 + [(1, 0.5, 1), (2, 0.005, 2), (2, 0.005, 1)]
-    c += [(1, 0.47, 1)] + [(2, 0.01, 1)] * 6 + [(0, 0.0, 3)] + [(2, -0.005, 1)] * 4
-    c += [(1, 0.9, 1)] + [(0, 0.0, 1)] * 4 + [(0, 0.0, 6)] * 5  # opens: the cube drops
+    from norm2tex.envs.commands import ABSOLUTE, DELTA, KEEP
+
+    c = [(DELTA, -0.005, 1)] * 4 + [(KEEP, 0.0, 1)] * 3
+    c += [(ABSOLUTE, 0.5, 1), (DELTA, 0.005, 2), (DELTA, 0.005, 1)]
+    c += [(ABSOLUTE, 0.47, 1)] + [(DELTA, 0.01, 1)] * 6 + [(KEEP, 0.0, 3)]
+    c += [(DELTA, -0.005, 1)] * 4
+    c += [(ABSOLUTE, 0.9, 1)] + [(KEEP, 0.0, 1)] * 4 + [(KEEP, 0.0, 6)] * 5  # opens: the cube drops
     return c
 
 
@@ -141,6 +145,7 @@ def test_same_frames_as_in_process(backends):
 
 def test_refusals_carry_contact_sims_reasons(backends):
     import norm2tex
+    from norm2tex.envs.commands import ABSOLUTE
 
     ros, inproc = backends
     ros.reset(0, 5)
@@ -154,7 +159,7 @@ def test_refusals_carry_contact_sims_reasons(backends):
     assert str(in_process.value) in str(over_ros.value)
     with pytest.raises(norm2tex.Error, match=r"~step refused, nothing changed: gripper opening "
                                              r"1\.5 is out of range; valid: \[0, 1\]"):
-        ros.step([1], [1.5])
+        ros.step([ABSOLUTE], [1.5])
     after = ros.state()
     for key in before:
         assert np.array_equal(before[key], after[key]), key  # nothing changed

@@ -8,11 +8,14 @@
 
 namespace norm2tex {
 
-/// What a batch step does to one gripper's command before it steps.
+/// What a batch step does to one gripper's command before it steps. kAbsolute and kDelta have
+/// the values of the message norm2tex/GripperCommand's ABSOLUTE and DELTA (the ROS layer checks
+/// it at compile time), kKeep comes after them: one set of values in C++, the message and Python
+/// (norm2tex/envs/commands.py).
 enum class OpeningCommand {
-  kKeep,      ///< leave the command as it is
-  kAbsolute,  ///< GripperSim::setOpening(value)
-  kDelta,     ///< GripperSim::addOpening(value) (clamped to [0, 1])
+  kAbsolute = 0,  ///< GripperSim::setOpening(value)
+  kDelta = 1,     ///< GripperSim::addOpening(value) (clamped to [0, 1])
+  kKeep = 2,      ///< leave the command as it is
 };
 
 /// N TactileGrippers stepped together on a fixed set of threads: all physics first (one job

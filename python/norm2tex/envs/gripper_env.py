@@ -15,10 +15,9 @@ import numpy as np
 
 import norm2tex
 from norm2tex.envs import spaces
-from norm2tex.envs.inprocess_backend import ABSOLUTE, DELTA, KEEP, InProcessBackend
-
-# The paper's discrete actions: close by 0.005, stay, open by 0.005 (normalised opening).
-DISCRETE_DELTA = 0.005
+from norm2tex.envs.commands import (ABSOLUTE, CLOSE, DELTA, DISCRETE_DELTA, KEEP, OPEN,  # noqa
+                                    STAY)
+from norm2tex.envs.inprocess_backend import InProcessBackend
 ACTIONS = ("discrete", "delta", "absolute")
 IMAGE_MODES = ("raw", "diff_int16", "diff_float")
 FINGERS = ("left", "right")
@@ -376,10 +375,12 @@ class GripperVectorEnv(spaces.EnvBase):
         for a in actions:
             if self.action_kind == "discrete":
                 a = int(np.asarray(a).reshape(()))
-                if a not in (0, 1, 2):
-                    raise ValueError("action %r; valid: 0 (close), 1 (stay), 2 (open)" % a)
-                modes.append(KEEP if a == 1 else DELTA)
-                values.append((a - 1) * DISCRETE_DELTA)
+                if a not in (CLOSE, STAY, OPEN):
+                    raise ValueError("action %r; valid: %d (CLOSE), %d (STAY), %d (OPEN)"
+                                     % (a, CLOSE, STAY, OPEN))
+                # The paper's step: close or open by DISCRETE_DELTA, or leave the command.
+                modes.append(KEEP if a == STAY else DELTA)
+                values.append({CLOSE: -DISCRETE_DELTA, STAY: 0.0, OPEN: DISCRETE_DELTA}[a])
             else:
                 v = float(np.asarray(a, dtype=np.float64).reshape(-1)[0])
                 if not math.isfinite(v):

@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from norm2tex.envs.gripper_env import GripperEnv, GripperVectorEnv
-from norm2tex.envs.inprocess_backend import ABSOLUTE
+from norm2tex.envs.commands import ABSOLUTE
 
 HORIZON = 128
 # empty=True: frames the gripper stays fully open after the grasp, for the cube to fall clear of

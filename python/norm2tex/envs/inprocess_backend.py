@@ -7,8 +7,7 @@ import numpy as np
 
 import norm2tex
 
-# Command modes of a backend step (TactileGripperBatch's).
-KEEP, ABSOLUTE, DELTA = 0, 1, 2
+from norm2tex.envs.commands import ABSOLUTE, DELTA, KEEP  # noqa: F401 (the modes of step)
 
 
 class InProcessBackend:

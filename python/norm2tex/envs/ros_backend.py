@@ -33,8 +33,7 @@ import numpy as np
 import norm2tex
 from norm2tex.envs.ros_client import RosClient, bgr8, frame_seconds
 
-# Command modes of a backend step (as InProcessBackend's).
-KEEP, ABSOLUTE, DELTA = 0, 1, 2
+from norm2tex.envs.commands import ABSOLUTE, DELTA, KEEP
 
 FINGERS = ("left", "right")
 
@@ -179,11 +178,11 @@ class RosBackend(RosClient):
         request.frames = int(frames)
         if mode == ABSOLUTE or mode == DELTA:
             request.set_command = True
-            request.command.mode = (self._GripperCommand.ABSOLUTE if mode == ABSOLUTE
-                                    else self._GripperCommand.DELTA)
+            request.command.mode = mode  # the message's own values (norm2tex.envs.commands)
             request.command.opening = value
         elif mode != KEEP:
-            raise ValueError("command mode %d; valid: 0 keep, 1 absolute, 2 delta" % mode)
+            raise ValueError("command mode %d; valid: 0 ABSOLUTE, 1 DELTA, 2 KEEP "
+                             "(norm2tex.envs.commands)" % mode)
         r = self._call("step", request)
         if not r.success:
             raise norm2tex.Error(r.message)
