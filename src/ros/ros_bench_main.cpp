@@ -188,6 +188,121 @@ int benchHandRealTime(ros::NodeHandle& nh, int frames) {
   return lost == 0 ? 0 : 1;
 }
 
+/// synchronous: the policy loop (one ~step, then both images of it) against contact_sim, then
+/// one ~step of every frame.
+int benchSynchronous(ros::NodeHandle& nh, Arrivals& arrivals, int frames) {
+  ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("contact_sim/step", true);
+  if (!step.waitForExistence(ros::Duration(60.0))) return fail("no contact_sim/step within 60 s");
+  norm2tex::Step srv;
+  srv.request.frames = 1;
+  for (int i = 0; i < 20; ++i) step.call(srv);  // warm up
+  waitFor([&] { return arrivals.count[srv.response.stamp] == 2; }, 10);
+  // The policy loop: step one frame, wait for both of its images.
+  ros::WallTime start = ros::WallTime::now();
+  for (int i = 0; i < frames; ++i) {
+    if (!step.call(srv) || !srv.response.success)
+      return fail(("~step failed: " + srv.response.message).c_str());
+    const ros::Time stamp = srv.response.stamp;
+    if (!waitFor([&] { return arrivals.count[stamp] == 2; }, 10))
+      return fail("a step's two images did not arrive within 10 s");
+  }
+  const double loop = (ros::WallTime::now() - start).toSec();
+  // One call for all frames, then wait for the last images.
+  const int before = arrivals.total;
+  start = ros::WallTime::now();
+  srv.request.frames = frames;
+  // The call blocks until every frame is answered: made from another thread, so that this one
+  // takes the images as they arrive, as a subscriber of its own would. (Held back until the
+  // call returned, all of them piled up here: 1200 fresh 230 kB buffers, ~30 page faults
+  // each, on the cores the renderers need.)
+  std::atomic<bool> called{false}, step_ok{false};
+  std::thread caller([&] {
+    step_ok = step.call(srv) && srv.response.success;
+    called = true;
+  });
+  // Until the call returned and every image is here, or none has come for 2 s (a subscriber
+  // that fell more than the publisher's queue behind lost some: reported below).
+  int seen = arrivals.total;
+  ros::WallTime last_arrival = ros::WallTime::now();
+  waitFor(
+      [&] {
+        const ros::WallTime now = ros::WallTime::now();
+        if (arrivals.total != seen) {
+          seen = arrivals.total;
+          last_arrival = now;
+        }
+        return called &&
+               (arrivals.total - before == 2 * frames || (now - last_arrival).toSec() > 2.0);
+      },
+      120);
+  caller.join();
+  if (!step_ok) return fail("~step failed");
+  const double batch = (last_arrival - start).toSec();
+  std::printf(
+      "synchronous, %d frames, both sensors delivered: policy loop (step 1 + wait) "
+      "%.0f frames/s (%.2f ms/frame); one ~step of %d frames %.0f frames/s "
+      "(%.2f ms/frame); %d images lost\n",
+      frames, frames / loop, 1e3 * loop / frames, frames, frames / batch, 1e3 * batch / frames,
+      2 * frames - (arrivals.total - before));
+  return 0;
+}
+
+/// real_time: from a frame's stamp (wall clock) to its images' arrival, p50 / p99 / max; with
+/// `split` also to its SimFrame; with `arrivals_file` each frame's arrivals as CSV.
+int benchRealTime(Arrivals& arrivals, int frames, bool split, const std::string& arrivals_file) {
+  // Real time: stamps are wall time (use_sim_time false).
+  waitFor([&] { return arrivals.total >= 2 * 60; }, 30);
+  arrivals = Arrivals{};
+  // Woken by each image (as a subscriber spinning its queue is), not by a 0.5 ms poll: 2000
+  // wake-ups a second of its own would compete with the renderers it measures.
+  waitFor([&] { return static_cast<int>(arrivals.count.size()) >= frames + 2; }, frames / 30.0 + 30,
+          /*poll_seconds=*/0.1);
+  std::vector<double> latency_ms, physics_ms, first_ms, second_ms;
+  int incomplete = 0;
+  // The oldest frame may have had its first image before counting started, the newest its
+  // second still on the way when counting stopped: neither is a frame with one image.
+  const ros::Time oldest = arrivals.count.begin()->first;
+  const ros::Time newest = arrivals.count.rbegin()->first;
+  for (const auto& [stamp, n] : arrivals.count) {
+    if (n != 2) {
+      if (stamp != oldest && stamp != newest) ++incomplete;
+      continue;
+    }
+    latency_ms.push_back(1e3 * (arrivals.last[stamp].toSec() - stamp.toSec()));
+    first_ms.push_back(1e3 * (arrivals.first[stamp].toSec() - stamp.toSec()));
+    second_ms.push_back(1e3 * (arrivals.last[stamp] - arrivals.first[stamp]).toSec());
+    const auto f = arrivals.frame.find(stamp);
+    if (f != arrivals.frame.end()) physics_ms.push_back(1e3 * (f->second.toSec() - stamp.toSec()));
+  }
+  if (latency_ms.size() < 10) return fail("fewer than 10 frames with both images");
+  if (!arrivals_file.empty()) {
+    std::ofstream out(arrivals_file);
+    out << "stamp_ns,first_ns,second_ns,first_frame_id\n";
+    for (const auto& [stamp, n] : arrivals.count) {
+      if (n != 2) continue;
+      out << stamp.toNSec() << ',' << arrivals.first[stamp].toNSec() << ','
+          << arrivals.last[stamp].toNSec() << ',' << arrivals.first_from[stamp] << '\n';
+    }
+    if (!out.flush()) return fail(("cannot write " + arrivals_file).c_str());
+  }
+  std::printf(
+      "real time, %zu frames: stamp -> both images here: p50 %.2f ms, p99 %.2f ms, "
+      "max %.2f ms; %d frames with one image\n",
+      latency_ms.size(), percentile(latency_ms, 0.5), percentile(latency_ms, 0.99),
+      percentile(latency_ms, 1.0), incomplete);
+  if (split) {
+    if (physics_ms.size() < 10) return fail("fewer than 10 frames with their SimFrame here");
+    std::printf("  stamp -> SimFrame here (physics done) p50 %.2f ms, p99 %.2f ms\n",
+                percentile(physics_ms, 0.5), percentile(physics_ms, 0.99));
+  }
+  std::printf(
+      "  stamp -> first image p50 %.2f ms, p99 %.2f ms; first -> second image p50 %.2f ms, "
+      "p99 %.2f ms\n",
+      percentile(first_ms, 0.5), percentile(first_ms, 0.99), percentile(second_ms, 0.5),
+      percentile(second_ms, 0.99));
+  return 0;
+}
+
 int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   // ros::init first: it takes its own arguments (name:=value remappings) off the command line.
   ros::init(argc, argv, "norm2tex_ros_bench", ros::init_options::AnonymousName);
@@ -249,114 +364,8 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
     return 1;
   }
 
-  if (mode == "synchronous") {
-    ros::ServiceClient step = nh.serviceClient<norm2tex::Step>("contact_sim/step", true);
-    if (!step.waitForExistence(ros::Duration(60.0))) return fail("no contact_sim/step within 60 s");
-    norm2tex::Step srv;
-    srv.request.frames = 1;
-    for (int i = 0; i < 20; ++i) step.call(srv);  // warm up
-    waitFor([&] { return arrivals.count[srv.response.stamp] == 2; }, 10);
-    // The policy loop: step one frame, wait for both of its images.
-    ros::WallTime start = ros::WallTime::now();
-    for (int i = 0; i < frames; ++i) {
-      if (!step.call(srv) || !srv.response.success)
-        return fail(("~step failed: " + srv.response.message).c_str());
-      const ros::Time stamp = srv.response.stamp;
-      if (!waitFor([&] { return arrivals.count[stamp] == 2; }, 10))
-        return fail("a step's two images did not arrive within 10 s");
-    }
-    const double loop = (ros::WallTime::now() - start).toSec();
-    // One call for all frames, then wait for the last images.
-    const int before = arrivals.total;
-    start = ros::WallTime::now();
-    srv.request.frames = frames;
-    // The call blocks until every frame is answered: made from another thread, so that this one
-    // takes the images as they arrive, as a subscriber of its own would. (Held back until the
-    // call returned, all of them piled up here: 1200 fresh 230 kB buffers, ~30 page faults
-    // each, on the cores the renderers need.)
-    std::atomic<bool> called{false}, step_ok{false};
-    std::thread caller([&] {
-      step_ok = step.call(srv) && srv.response.success;
-      called = true;
-    });
-    // Until the call returned and every image is here, or none has come for 2 s (a subscriber
-    // that fell more than the publisher's queue behind lost some: reported below).
-    int seen = arrivals.total;
-    ros::WallTime last_arrival = ros::WallTime::now();
-    waitFor(
-        [&] {
-          const ros::WallTime now = ros::WallTime::now();
-          if (arrivals.total != seen) {
-            seen = arrivals.total;
-            last_arrival = now;
-          }
-          return called &&
-                 (arrivals.total - before == 2 * frames || (now - last_arrival).toSec() > 2.0);
-        },
-        120);
-    caller.join();
-    if (!step_ok) return fail("~step failed");
-    const double batch = (last_arrival - start).toSec();
-    std::printf(
-        "synchronous, %d frames, both sensors delivered: policy loop (step 1 + wait) "
-        "%.0f frames/s (%.2f ms/frame); one ~step of %d frames %.0f frames/s "
-        "(%.2f ms/frame); %d images lost\n",
-        frames, frames / loop, 1e3 * loop / frames, frames, frames / batch, 1e3 * batch / frames,
-        2 * frames - (arrivals.total - before));
-    return 0;
-  }
-
-  // Real time: stamps are wall time (use_sim_time false).
-  waitFor([&] { return arrivals.total >= 2 * 60; }, 30);
-  arrivals = Arrivals{};
-  // Woken by each image (as a subscriber spinning its queue is), not by a 0.5 ms poll: 2000
-  // wake-ups a second of its own would compete with the renderers it measures.
-  waitFor([&] { return static_cast<int>(arrivals.count.size()) >= frames + 2; }, frames / 30.0 + 30,
-          /*poll_seconds=*/0.1);
-  std::vector<double> latency_ms, physics_ms, first_ms, second_ms;
-  int incomplete = 0;
-  // The oldest frame may have had its first image before counting started, the newest its
-  // second still on the way when counting stopped: neither is a frame with one image.
-  const ros::Time oldest = arrivals.count.begin()->first;
-  const ros::Time newest = arrivals.count.rbegin()->first;
-  for (const auto& [stamp, n] : arrivals.count) {
-    if (n != 2) {
-      if (stamp != oldest && stamp != newest) ++incomplete;
-      continue;
-    }
-    latency_ms.push_back(1e3 * (arrivals.last[stamp].toSec() - stamp.toSec()));
-    first_ms.push_back(1e3 * (arrivals.first[stamp].toSec() - stamp.toSec()));
-    second_ms.push_back(1e3 * (arrivals.last[stamp] - arrivals.first[stamp]).toSec());
-    const auto f = arrivals.frame.find(stamp);
-    if (f != arrivals.frame.end()) physics_ms.push_back(1e3 * (f->second.toSec() - stamp.toSec()));
-  }
-  if (latency_ms.size() < 10) return fail("fewer than 10 frames with both images");
-  if (!arrivals_file.empty()) {
-    std::ofstream out(arrivals_file);
-    out << "stamp_ns,first_ns,second_ns,first_frame_id\n";
-    for (const auto& [stamp, n] : arrivals.count) {
-      if (n != 2) continue;
-      out << stamp.toNSec() << ',' << arrivals.first[stamp].toNSec() << ','
-          << arrivals.last[stamp].toNSec() << ',' << arrivals.first_from[stamp] << '\n';
-    }
-    if (!out.flush()) return fail(("cannot write " + arrivals_file).c_str());
-  }
-  std::printf(
-      "real time, %zu frames: stamp -> both images here: p50 %.2f ms, p99 %.2f ms, "
-      "max %.2f ms; %d frames with one image\n",
-      latency_ms.size(), percentile(latency_ms, 0.5), percentile(latency_ms, 0.99),
-      percentile(latency_ms, 1.0), incomplete);
-  if (split) {
-    if (physics_ms.size() < 10) return fail("fewer than 10 frames with their SimFrame here");
-    std::printf("  stamp -> SimFrame here (physics done) p50 %.2f ms, p99 %.2f ms\n",
-                percentile(physics_ms, 0.5), percentile(physics_ms, 0.99));
-  }
-  std::printf(
-      "  stamp -> first image p50 %.2f ms, p99 %.2f ms; first -> second image p50 %.2f ms, "
-      "p99 %.2f ms\n",
-      percentile(first_ms, 0.5), percentile(first_ms, 0.99), percentile(second_ms, 0.5),
-      percentile(second_ms, 0.99));
-  return 0;
+  if (mode == "synchronous") return benchSynchronous(nh, arrivals, frames);
+  return benchRealTime(arrivals, frames, split, arrivals_file);
 }
 
 int main(int argc, char** argv) {
