@@ -279,26 +279,103 @@ bool TactileRendererRos::anyoneListens() const {
          depth_pub_.getNumSubscribers() > 0 || (mask_pub_ && mask_pub_.getNumSubscribers() > 0);
 }
 
+void TactileRendererRos::placeFrameThread() {
+  // ~cpu: the two sensors' frame threads wake for the same SimFrame microseconds apart. Left
+  // to the scheduler, the second was often woken onto the CPU where the first had started,
+  // preempted it, and the first then stayed there (cache-hot) while the other CPU idled: in a
+  // third of the frames the two renders ran one after the other (+2 ms). One CPU each keeps
+  // them in parallel.
+  frame_thread_placed_ = true;
+  if (params_.cpu < 0) return;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(params_.cpu, &set);
+  if (sched_setaffinity(0, sizeof set, &set) != 0) {
+    ROS_WARN("%s: ~cpu %d: %s", params_.sensor_name.c_str(), params_.cpu, std::strerror(errno));
+  }
+}
+
+bool TactileRendererRos::answerAgain(const SimFrame& frame) {
+  if (!frame.acknowledge || !answered_any_ || frame.frame > last_answered_frame_) return false;
+  // Offered again (a source re-offers frames it has no answer to from everyone): answer again,
+  // never render twice; a frame older than the answers kept is ignored.
+  const auto it = recent_answers_.find(frame.frame);
+  if (it != recent_answers_.end() && it->second.header.stamp == frame.header.stamp) {
+    rendered_pub_.publish(it->second);
+  }
+  return true;
+}
+
+Eigen::Isometry3d TactileRendererRos::objectInGelAt(const ros::Time& stamp) {
+  // The pose at exactly this stamp: wait (wall clock: simulated time may stand still) for TF,
+  // never extrapolate or take a stale pose.
+  std::string why;
+  if (!tf_waiter_.wait(params_.gel_frame, params_.object_frame, stamp, params_.tf_timeout, &why)) {
+    if (!ros::ok()) throw Error("shutting down");
+    std::ostringstream reason;
+    reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at " << stamp
+           << " not available within ~tf_timeout = " << params_.tf_timeout << " s (" << why
+           << ")";
+    throw Error(reason.str());
+  }
+  return ros_conversions::fromTransformMsg(
+      tf_buffer_.lookupTransform(params_.gel_frame, params_.object_frame, stamp).transform);
+}
+
+std::optional<double> TactileRendererRos::normalForceIn(const SimFrame& frame) const {
+  // The gel's normal force when the source knows it (contact_sim), for the texture's
+  // conformity; else the renderer takes the gel law's force for the press.
+  for (std::size_t i = 0; i < frame.sensors.size() && i < frame.normal_force.size(); ++i) {
+    if (frame.sensors[i] == params_.sensor_name) return frame.normal_force[i];
+  }
+  return std::nullopt;
+}
+
+void TactileRendererRos::renderAndPublish(const SimFrame& frame) {
+  const Eigen::Isometry3d object_in_gel = objectInGelAt(frame.header.stamp);
+  trace_.mark(kTracePose);
+  const std::int64_t noise_seed = params_.noise_seed < 0
+                                      ? -1
+                                      : static_cast<std::int64_t>(params_.noise_seed) * 1000003 +
+                                            static_cast<std::int64_t>(frame.frame);
+  const std::optional<double> normal_force_n = normalForceIn(frame);
+  const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed, normal_force_n);
+  trace_.mark(kTraceRendered);
+  if (params_.rehearse_ms > 0.0 && !frame.acknowledge) {
+    last_frame_.object_in_gel = object_in_gel;
+    last_frame_.noise_seed = noise_seed;
+    last_frame_.normal_force_n = normal_force_n;
+  }
+  std_msgs::Header header;
+  header.stamp = frame.header.stamp;
+  header.frame_id = params_.gel_frame;
+  // The image always (one per frame); the others are built only for someone (a 300 kB depth
+  // copy per frame is not free).
+  image_pub_.publish(ros_conversions::toImageMsg(header, rendered.image));
+  trace_.mark(kTracePublished);
+  if (info_pub_.getNumSubscribers() > 0) {
+    info_pub_.publish(ros_conversions::toCameraInfo(header, renderer_->model()));
+  }
+  if (depth_pub_.getNumSubscribers() > 0) {
+    depth_pub_.publish(ros_conversions::toImageMsg(header, rendered.depthMetres()));
+  }
+  if (mask_pub_ && mask_pub_.getNumSubscribers() > 0) {
+    mask_pub_.publish(ros_conversions::toImageMsg(header, rendered.contact_mask));
+  }
+}
+
+void TactileRendererRos::keepAnswer(const FrameRendered& answer) {
+  rendered_pub_.publish(answer);
+  recent_answers_[answer.frame] = answer;
+  if (recent_answers_.size() > 256) recent_answers_.erase(recent_answers_.begin());
+  last_answered_frame_ = answer.frame;
+  answered_any_ = true;
+}
+
 void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   const ros::WallTime received = ros::WallTime::now();
   ++last_frame_.count;
-  if (!frame_thread_placed_) {
-    // ~cpu: the two sensors' frame threads wake for the same SimFrame microseconds apart. Left
-    // to the scheduler, the second was often woken onto the CPU where the first had started,
-    // preempted it, and the first then stayed there (cache-hot) while the other CPU idled: in a
-    // third of the frames the two renders ran one after the other (+2 ms). One CPU each keeps
-    // them in parallel.
-    frame_thread_placed_ = true;
-    if (params_.cpu >= 0) {
-      cpu_set_t set;
-      CPU_ZERO(&set);
-      CPU_SET(params_.cpu, &set);
-      if (sched_setaffinity(0, sizeof set, &set) != 0) {
-        ROS_WARN("%s: ~cpu %d: %s", params_.sensor_name.c_str(), params_.cpu,
-                 std::strerror(errno));
-      }
-    }
-  }
+  if (!frame_thread_placed_) placeFrameThread();
   if (trace_.enabled()) {
     trace_.begin(frame->header.stamp);
     trace_.mark(kTraceReceived);
@@ -313,15 +390,7 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
     tf_waiter_.insertReceived();
     return;
   }
-  if (frame->acknowledge && answered_any_ && frame->frame <= last_answered_frame_) {
-    // Offered again (a source re-offers frames it has no answer to from everyone): answer
-    // again, never render twice; a frame older than the answers kept is ignored.
-    const auto it = recent_answers_.find(frame->frame);
-    if (it != recent_answers_.end() && it->second.header.stamp == frame->header.stamp) {
-      rendered_pub_.publish(it->second);
-    }
-    return;
-  }
+  if (answerAgain(*frame)) return;
   FrameRendered answer;
   answer.header.stamp = frame->header.stamp;
   answer.header.frame_id = params_.gel_frame;
@@ -329,55 +398,7 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   answer.frame = frame->frame;
   try {
     if (params_.texture_from_frame) followFrameTexture(*frame);
-    // The pose at exactly this stamp: wait (wall clock: simulated time may stand still) for TF,
-    // never extrapolate or take a stale pose.
-    std::string why;
-    if (!tf_waiter_.wait(params_.gel_frame, params_.object_frame, frame->header.stamp,
-                         params_.tf_timeout, &why)) {
-      if (!ros::ok()) throw Error("shutting down");
-      std::ostringstream reason;
-      reason << "TF " << params_.object_frame << " -> " << params_.gel_frame << " at "
-             << frame->header.stamp << " not available within ~tf_timeout = " << params_.tf_timeout
-             << " s (" << why << ")";
-      throw Error(reason.str());
-    }
-    const Eigen::Isometry3d object_in_gel = ros_conversions::fromTransformMsg(
-        tf_buffer_.lookupTransform(params_.gel_frame, params_.object_frame, frame->header.stamp)
-            .transform);
-    trace_.mark(kTracePose);
-    const std::int64_t noise_seed = params_.noise_seed < 0
-                                        ? -1
-                                        : static_cast<std::int64_t>(params_.noise_seed) * 1000003 +
-                                              static_cast<std::int64_t>(frame->frame);
-    // The gel's normal force when the source knows it (contact_sim), for the texture's
-    // conformity; else the renderer takes the gel law's force for the press.
-    std::optional<double> normal_force_n;
-    for (std::size_t i = 0; i < frame->sensors.size() && i < frame->normal_force.size(); ++i) {
-      if (frame->sensors[i] == params_.sensor_name) normal_force_n = frame->normal_force[i];
-    }
-    const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed, normal_force_n);
-    trace_.mark(kTraceRendered);
-    if (params_.rehearse_ms > 0.0 && !frame->acknowledge) {
-      last_frame_.object_in_gel = object_in_gel;
-      last_frame_.noise_seed = noise_seed;
-      last_frame_.normal_force_n = normal_force_n;
-    }
-    std_msgs::Header header;
-    header.stamp = frame->header.stamp;
-    header.frame_id = params_.gel_frame;
-    // The image always (one per frame); the others are built only for someone (a 300 kB depth
-    // copy per frame is not free).
-    image_pub_.publish(ros_conversions::toImageMsg(header, rendered.image));
-    trace_.mark(kTracePublished);
-    if (info_pub_.getNumSubscribers() > 0) {
-      info_pub_.publish(ros_conversions::toCameraInfo(header, renderer_->model()));
-    }
-    if (depth_pub_.getNumSubscribers() > 0) {
-      depth_pub_.publish(ros_conversions::toImageMsg(header, rendered.depthMetres()));
-    }
-    if (mask_pub_ && mask_pub_.getNumSubscribers() > 0) {
-      mask_pub_.publish(ros_conversions::toImageMsg(header, rendered.contact_mask));
-    }
+    renderAndPublish(*frame);
     answer.published = true;
     ++rendered_;
   } catch (const Error& e) {
@@ -392,13 +413,7 @@ void TactileRendererRos::onFrame(const SimFrame::ConstPtr& frame) {
   if (params_.rehearse_ms > 0.0 && !frame->acknowledge && answer.published) {
     scheduleRehearsal(frame->header.stamp, received);
   }
-  if (frame->acknowledge) {
-    rendered_pub_.publish(answer);
-    recent_answers_[answer.frame] = answer;
-    if (recent_answers_.size() > 256) recent_answers_.erase(recent_answers_.begin());
-    last_answered_frame_ = answer.frame;
-    answered_any_ = true;
-  }
+  if (frame->acknowledge) keepAnswer(answer);
 }
 
 void TactileRendererRos::scheduleRehearsal(const ros::Time& stamp, const ros::WallTime& received) {

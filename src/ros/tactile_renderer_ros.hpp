@@ -87,6 +87,18 @@ class TactileRendererRos {
 
  private:
   void onFrame(const SimFrame::ConstPtr& frame);
+  /// ~cpu: pins the frame thread (once, from its first frame).
+  void placeFrameThread();
+  /// A frame offered again: answers it as before (or ignores one too old) and returns true.
+  bool answerAgain(const SimFrame& frame);
+  /// The object in the gel frame at exactly `stamp` (TF, waited for); throws Error naming why not.
+  Eigen::Isometry3d objectInGelAt(const ros::Time& stamp);
+  /// The gel's normal force the source gives for this sensor, if it gives one.
+  std::optional<double> normalForceIn(const SimFrame& frame) const;
+  /// Renders the frame and publishes its image (and camera_info, depth, mask to listeners).
+  void renderAndPublish(const SimFrame& frame);
+  /// Publishes a synchronous frame's answer and keeps it for a frame offered again.
+  void keepAnswer(const FrameRendered& answer);
   bool anyoneListens() const;
   /// Loads (or takes from the cache) a texture and gives it to the renderer.
   void useTexture(const TextureSource& source, const std::string& key);
