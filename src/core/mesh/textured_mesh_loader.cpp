@@ -118,10 +118,9 @@ std::vector<unsigned char> embeddedTexture(const std::string& reference, const a
   return std::vector<unsigned char>(bytes, bytes + texture->mWidth);
 }
 
-}  // namespace
-
-TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& options) {
-  const std::string what = "mesh '" + path + "'";
+// The file exists, is a regular, readable, non-empty file, and the scale is usable; else Error.
+void checkMeshFile(const std::string& path, const MeshLoadOptions& options,
+                   const std::string& what) {
   if (path.empty()) throw Error("mesh: no file name given");
   if (!std::isfinite(options.scale) || !(options.scale > 0.0)) {
     std::ostringstream message;
@@ -135,8 +134,12 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
     throw Error(what + " cannot be opened (permissions?)");
   }
   if (fs::file_size(path, ec) == 0) throw Error(what + " is an empty file");
+}
 
-  Assimp::Importer importer;
+// assimp's scene of the file (owned by `importer`), triangulated, identical vertices joined;
+// Error for a file it cannot read or one without meshes.
+const aiScene& importScene(Assimp::Importer& importer, const std::string& path,
+                           const std::string& what) {
   // Normals, colours and tangents are not used, and keeping them would stop
   // JoinIdenticalVertices from merging vertices that differ only there (STL stores one normal
   // per facet, so no vertex would ever be shared). Joining then depends on position and UVs.
@@ -169,22 +172,103 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0 || scene->mMeshes == nullptr) {
     throw Error(what + " has no triangles");
   }
+  return *scene;
+}
 
-  // Flatten the node tree: every node's meshes, with the node's accumulated transform, in
-  // metres. Iterative so a deep hierarchy cannot exhaust the call stack.
-  const Eigen::Matrix4d scale =
-      Eigen::Vector4d(options.scale, options.scale, options.scale, 1.0).asDiagonal();
+// The scene's meshes flattened into one: every node's meshes with the node's accumulated
+// transform, in metres, and the first normal texture a mesh's material names.
+struct FlatMesh {
   std::vector<Eigen::Vector3f> vertices;
   std::vector<Eigen::Vector3i> triangles;
   std::vector<Eigen::Vector2f> uvs;
   bool any_uvs = false;
   std::string texture_reference;
-  const fs::path mesh_directory = fs::absolute(fs::path(path), ec).parent_path();
-  std::vector<fs::path> texture_directories{mesh_directory};
+  std::vector<fs::path> texture_directories;  // where to look for it, first first
   // An .obj's material libraries as we read them (mtl_file.hpp), read once when needed.
   std::optional<std::vector<detail::ObjMaterial>> obj_materials;
+};
+
+// The normal texture `mesh`'s material names, when none was found yet.
+void findNormalTexture(const aiScene& scene, const aiMesh& mesh, const std::string& path,
+                       FlatMesh& flat) {
+  if (!flat.texture_reference.empty() || mesh.mMaterialIndex >= scene.mNumMaterials ||
+      scene.mMaterials == nullptr) {
+    return;
+  }
+  const aiMaterial* material = scene.mMaterials[mesh.mMaterialIndex];
+  flat.texture_reference = normalTextureOf(material);
+  if (!isObjFile(path)) return;
+  // The .mtl as we read it decides, so an .obj finds the same texture on every assimp: < 5.1
+  // skips `norm`, and releases differ on quoted names, option arguments and keyword case.
+  // assimp's reading stays for a material we cannot find by name.
+  if (!flat.obj_materials) flat.obj_materials = detail::readObjMaterials(path);
+  const detail::ObjMaterial* own =
+      detail::findObjMaterial(*flat.obj_materials, materialName(material));
+  if (own != nullptr && !own->material.normalTexture().empty()) {
+    flat.texture_reference = own->material.normalTexture();
+  }
+  if (own != nullptr && !flat.texture_reference.empty()) {
+    flat.texture_directories.insert(flat.texture_directories.begin(), own->mtl_directory);
+  }
+}
+
+// Appends `mesh`'s triangles, and its vertices and UVs placed by `transform`.
+void appendMesh(const aiMesh& mesh, const Eigen::Matrix4d& transform, const std::string& what,
+                FlatMesh& flat) {
+  const size_t offset = flat.vertices.size();
+  if (offset + mesh.mNumVertices > static_cast<size_t>(std::numeric_limits<int>::max())) {
+    throw Error(what + " has more vertices than supported");
+  }
+  size_t mesh_triangles = 0;
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices != 3) continue;
+    Eigen::Vector3i triangle;
+    for (int k = 0; k < 3; ++k) {
+      if (face.mIndices[k] >= mesh.mNumVertices) {
+        throw Error(what + " is corrupt: a face refers to a vertex that does not exist");
+      }
+      triangle[k] = static_cast<int>(offset + face.mIndices[k]);
+    }
+    flat.triangles.push_back(triangle);
+    ++mesh_triangles;
+  }
+  if (mesh_triangles == 0) return;
+
+  flat.vertices.reserve(offset + mesh.mNumVertices);
+  const Eigen::Matrix3d linear = transform.topLeftCorner<3, 3>();
+  const Eigen::Vector3d translation = transform.topRightCorner<3, 1>();
+  for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+    const aiVector3D& p = mesh.mVertices[v];
+    flat.vertices.push_back((linear * Eigen::Vector3d(p.x, p.y, p.z) + translation).cast<float>());
+  }
+  // UV policy: as soon as one mesh has UVs the merged mesh has them; meshes without get
+  // (0, 0) so every vertex has one (see TexturedMesh).
+  const bool has_uvs = mesh.HasTextureCoords(0);
+  if (has_uvs && !flat.any_uvs) {
+    flat.uvs.assign(offset, Eigen::Vector2f::Zero());
+    flat.any_uvs = true;
+  }
+  if (flat.any_uvs) {
+    flat.uvs.reserve(flat.vertices.size());
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      flat.uvs.push_back(
+          has_uvs ? Eigen::Vector2f(mesh.mTextureCoords[0][v].x, mesh.mTextureCoords[0][v].y)
+                  : Eigen::Vector2f::Zero());
+    }
+  }
+}
+
+// Flattens the node tree, iteratively so a deep hierarchy cannot exhaust the call stack.
+FlatMesh flattenScene(const aiScene& scene, const std::string& path, double scale_factor,
+                      const std::string& what) {
+  FlatMesh flat;
+  std::error_code ec;
+  flat.texture_directories.push_back(fs::absolute(fs::path(path), ec).parent_path());
+  const Eigen::Matrix4d scale =
+      Eigen::Vector4d(scale_factor, scale_factor, scale_factor, 1.0).asDiagonal();
   std::vector<std::pair<const aiNode*, Eigen::Matrix4d>> pending{
-      {scene->mRootNode, scale * toEigen(scene->mRootNode->mTransformation)}};
+      {scene.mRootNode, scale * toEigen(scene.mRootNode->mTransformation)}};
   std::unordered_set<const aiNode*> visited;
   while (!pending.empty()) {
     const auto [node, transform] = pending.back();
@@ -196,89 +280,44 @@ TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& 
         pending.emplace_back(child, transform * toEigen(child->mTransformation));
     }
     for (unsigned m = 0; m < node->mNumMeshes; ++m) {
-      if (node->mMeshes[m] >= scene->mNumMeshes) continue;
-      const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
+      if (node->mMeshes[m] >= scene.mNumMeshes) continue;
+      const aiMesh* mesh = scene.mMeshes[node->mMeshes[m]];
       if (mesh == nullptr || mesh->mVertices == nullptr ||
           !(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) {
         continue;  // points and lines: nothing to press into the gel
       }
-      const size_t offset = vertices.size();
-      if (offset + mesh->mNumVertices > static_cast<size_t>(std::numeric_limits<int>::max())) {
-        throw Error(what + " has more vertices than supported");
-      }
-      size_t mesh_triangles = 0;
-      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-        const aiFace& face = mesh->mFaces[f];
-        if (face.mNumIndices != 3) continue;
-        Eigen::Vector3i triangle;
-        for (int k = 0; k < 3; ++k) {
-          if (face.mIndices[k] >= mesh->mNumVertices) {
-            throw Error(what + " is corrupt: a face refers to a vertex that does not exist");
-          }
-          triangle[k] = static_cast<int>(offset + face.mIndices[k]);
-        }
-        triangles.push_back(triangle);
-        ++mesh_triangles;
-      }
-      if (mesh_triangles == 0) continue;
-
-      vertices.reserve(offset + mesh->mNumVertices);
-      const Eigen::Matrix3d linear = transform.topLeftCorner<3, 3>();
-      const Eigen::Vector3d translation = transform.topRightCorner<3, 1>();
-      for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-        const aiVector3D& p = mesh->mVertices[v];
-        vertices.push_back((linear * Eigen::Vector3d(p.x, p.y, p.z) + translation).cast<float>());
-      }
-      // UV policy: as soon as one mesh has UVs the merged mesh has them; meshes without get
-      // (0, 0) so every vertex has one (see TexturedMesh).
-      const bool has_uvs = mesh->HasTextureCoords(0);
-      if (has_uvs && !any_uvs) {
-        uvs.assign(offset, Eigen::Vector2f::Zero());
-        any_uvs = true;
-      }
-      if (any_uvs) {
-        uvs.reserve(vertices.size());
-        for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-          uvs.push_back(
-              has_uvs ? Eigen::Vector2f(mesh->mTextureCoords[0][v].x, mesh->mTextureCoords[0][v].y)
-                      : Eigen::Vector2f::Zero());
-        }
-      }
-      if (texture_reference.empty() && mesh->mMaterialIndex < scene->mNumMaterials &&
-          scene->mMaterials != nullptr) {
-        const aiMaterial* material = scene->mMaterials[mesh->mMaterialIndex];
-        texture_reference = normalTextureOf(material);
-        if (isObjFile(path)) {
-          // The .mtl as we read it decides, so an .obj finds the same texture on every assimp:
-          // < 5.1 skips `norm`, and releases differ on quoted names, option arguments and
-          // keyword case. assimp's reading stays for a material we cannot find by name.
-          if (!obj_materials) obj_materials = detail::readObjMaterials(path);
-          const detail::ObjMaterial* own =
-              detail::findObjMaterial(*obj_materials, materialName(material));
-          if (own != nullptr && !own->material.normalTexture().empty()) {
-            texture_reference = own->material.normalTexture();
-          }
-          if (own != nullptr && !texture_reference.empty()) {
-            texture_directories.insert(texture_directories.begin(), own->mtl_directory);
-          }
-        }
-      }
+      const size_t triangles_before = flat.triangles.size();
+      appendMesh(*mesh, transform, what, flat);
+      if (flat.triangles.size() == triangles_before) continue;
+      findNormalTexture(scene, *mesh, path, flat);
     }
   }
-  if (triangles.empty()) throw Error(what + " has no triangles");
+  if (flat.triangles.empty()) throw Error(what + " has no triangles");
+  return flat;
+}
+
+}  // namespace
+
+TexturedMesh TexturedMesh::load(const std::string& path, const MeshLoadOptions& options) {
+  const std::string what = "mesh '" + path + "'";
+  checkMeshFile(path, options, what);
+  Assimp::Importer importer;
+  const aiScene& scene = importScene(importer, path, what);
+  FlatMesh flat = flattenScene(scene, path, options.scale, what);
 
   TexturedMesh result;
   try {
-    result = TexturedMesh(std::move(vertices), std::move(triangles), std::move(uvs));
+    result = TexturedMesh(std::move(flat.vertices), std::move(flat.triangles), std::move(flat.uvs));
   } catch (const Error& e) {
     // "mesh: vertex 3 has a non-finite coordinate" -> "mesh 'x.obj': vertex 3 ...".
     std::string detail = e.what();
     if (detail.rfind("mesh: ", 0) == 0) detail.erase(0, 6);
     throw Error(what + ": " + detail);
   }
-  result.normal_texture_path_ = resolveTexture(texture_reference, *scene, texture_directories);
-  result.normal_texture_reference_ = texture_reference;
-  result.embedded_normal_texture_ = embeddedTexture(texture_reference, *scene);
+  result.normal_texture_path_ =
+      resolveTexture(flat.texture_reference, scene, flat.texture_directories);
+  result.normal_texture_reference_ = flat.texture_reference;
+  result.embedded_normal_texture_ = embeddedTexture(flat.texture_reference, scene);
   result.source_path_ = path;
   return result;
 }
