@@ -232,171 +232,212 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
   return fit;
 }
 
+namespace {
+
+// The search of fitShadingAndGeometry: the scale (unless given) and the contact radius factor
+// within what the ball can make, the best fit kept.
+class GeometrySearch {
+ public:
+  GeometrySearch(const SensorModel& base, const std::vector<PressObservation>& presses,
+                 double ball_radius_mm, std::optional<double> mm_per_pixel)
+      : model_(base), ball_radius_mm_(ball_radius_mm), mm_per_pixel_(mm_per_pixel) {
+    largest_ = &presses.front();
+    for (const PressObservation& p : presses) {
+      if (p.circle.radius_px > largest_->circle.radius_px) largest_ = &p;
+    }
+    largest_radius_px_ = largest_->circle.radius_px;
+    const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
+    scale_lo_ = kMinSearchedScale * qvga;
+    scale_hi_ = kMaxSearchedScale * qvga;
+    // Searching the scale renders every press for each candidate: with many presses, search on
+    // an evenly spread subset of kMaxSearchPresses, then fit the response on all of them.
+    use_subset_ = !mm_per_pixel && presses.size() > kMaxSearchPresses;
+    if (use_subset_) {
+      for (size_t i = 0; i < kMaxSearchPresses; ++i) {
+        subset_.push_back(presses[i * presses.size() / kMaxSearchPresses]);
+      }
+    }
+    search_ = use_subset_ ? &subset_ : &presses;
+    best_.variance_explained = -1e300;
+  }
+
+  // A given scale is used as given, never changed: the radius factor is held to what the ball
+  // can make at it, and where not even the smallest factor fits, the scale is refused.
+  void checkTheBallCanMakeThePresses() const {
+    if (mm_per_pixel_ && feasibleFactor(*mm_per_pixel_) < kFactorLo) {
+      std::ostringstream message;
+      message << std::setprecision(4) << "mm per pixel " << *mm_per_pixel_ << " refused: press '"
+              << largest_->name << "' has a contact circle of radius " << largest_radius_px_
+              << " px, " << largest_radius_px_ * *mm_per_pixel_ << " mm at that scale; even "
+              << kFactorLo
+              << " of it (the least the fit takes a detected radius to be) is wider than a ball "
+              << "of radius " << ball_radius_mm_ << " mm (diameter " << 2.0 * ball_radius_mm_
+              << " mm) can make; check --ball-diameter-mm and --mm-per-pixel (or leave the "
+              << "scale out to fit it)";
+      throw Error(message.str());
+    }
+    if (!mm_per_pixel_ && feasibleScale(kFactorLo) < scale_lo_) {
+      std::ostringstream message;
+      message << "the largest press (contact radius " << largest_radius_px_
+              << " px) is wider than a ball of diameter " << 2.0 * ball_radius_mm_
+              << " mm can make at any plausible scale (>= " << scale_lo_
+              << " mm/px); check --ball-diameter-mm";
+      throw Error(message.str());
+    }
+  }
+
+  // Fits at `g` with rim-shadow width `sigma`; keeps the fit if it is the best so far.
+  bool tryGeometry(PressGeometry g, double sigma) { return keepIfBetter(fitAt(g, sigma)); }
+
+  // Coarse grid: factor in steps of 0.1, scale log-spaced (kScaleSteps over the range). When the
+  // scale is searched, the best fit at each grid scale is its profile.
+  ScaleSearch coarseGrid(double sigma) {
+    std::vector<ScaleProfilePoint> profile(kScaleSteps);
+    // With a given scale, the grid's factors above the ball's limit are all clamped to it: the
+    // first of them is tried, the rest not.
+    const double factor_top =
+        mm_per_pixel_ ? std::min(kFactorHi, feasibleFactor(*mm_per_pixel_)) : kFactorHi;
+    for (double factor = kFactorLo; factor <= factor_top + 0.1 - 1e-9; factor += 0.1) {
+      const double top = std::min(scale_hi_, feasibleScale(factor));
+      for (int i = 0; i < (mm_per_pixel_ ? 1 : kScaleSteps); ++i) {
+        const double scale = scale_lo_ * std::pow(scaleRatio(), i);
+        if (!mm_per_pixel_ && scale > top) break;
+        const std::optional<ShadingFit> fit = fitAt({scale, factor}, sigma);
+        keepIfBetter(fit);
+        if (fit && (profile[i].mm_per_pixel == 0.0 ||
+                    fit->variance_explained > profile[i].variance_explained)) {
+          profile[i] = {fit->geometry.mm_per_pixel, fit->geometry.radius_factor,
+                        fit->variance_explained};
+        }
+      }
+    }
+    return mm_per_pixel_ ? ScaleSearch{} : summariseScaleSearch(std::move(profile));
+  }
+
+  // Local pattern search around the best, `iterations` rounds, halving the steps (the scale's
+  // in log) when nothing improves; `sigma` null: the best fit's own rim-shadow width.
+  void patternSearch(int iterations, double scale_step, double factor_step,
+                     std::optional<double> sigma) {
+    for (int iteration = 0; iteration < iterations; ++iteration) {
+      const PressGeometry centre = best_.geometry;
+      const double at_sigma = sigma ? *sigma : best_.shading.shadow_sigma_mm;
+      bool improved = false;
+      for (const double factor_move : {-1.0, 0.0, 1.0}) {
+        for (const double scale_move : {-1.0, 0.0, 1.0}) {
+          if ((factor_move == 0.0 && scale_move == 0.0) || (mm_per_pixel_ && scale_move != 0.0)) {
+            continue;
+          }
+          improved |= tryGeometry({centre.mm_per_pixel * std::pow(scale_step, scale_move),
+                                   centre.radius_factor + factor_move * factor_step},
+                                  at_sigma);
+        }
+      }
+      if (!improved) {
+        scale_step = std::sqrt(scale_step);
+        factor_step *= 0.5;
+      }
+    }
+  }
+
+  // The best fit; with a subset searched, its geometry's fit on every press.
+  ShadingFit result(const std::vector<PressObservation>& presses) const {
+    ShadingFit best = best_;
+    const double s = best.geometry.mm_per_pixel;
+    best.scale_at_search_bound =
+        !mm_per_pixel_ &&
+        (s <= scale_lo_ * 1.01 ||
+         s >= 0.99 * std::min(scale_hi_, feasibleScale(best.geometry.radius_factor)));
+    if (use_subset_) {
+      const bool at_bound = best.scale_at_search_bound;
+      best = fitShadingResponse(model_, presses, best.geometry, ball_radius_mm_,
+                                best.shading.shadow_sigma_mm);
+      best.scale_at_search_bound = at_bound;
+    }
+    return best;
+  }
+
+  const ShadingFit& best() const { return best_; }
+  double scaleRatio() const { return std::pow(scale_hi_ / scale_lo_, 1.0 / (kScaleSteps - 1)); }
+
+ private:
+  static constexpr double kFactorLo = 0.6, kFactorHi = 1.3;
+  static constexpr int kScaleSteps = 12;
+
+  // Largest scale at which every contact (radius x factor) still fits the ball.
+  double feasibleScale(double factor) const {
+    return 0.97 * ball_radius_mm_ / (factor * largest_radius_px_);
+  }
+  // Largest radius factor at which every contact still fits the ball at a given scale.
+  double feasibleFactor(double scale) const {
+    return 0.97 * ball_radius_mm_ / (scale * largest_radius_px_);
+  }
+
+  // The fit at `g` (clamped to the searched ranges), or nothing where the ball cannot make it.
+  // With a given scale the factor gives way to the ball, never the scale.
+  std::optional<ShadingFit> fitAt(PressGeometry g, double sigma) const {
+    if (mm_per_pixel_) {
+      g.mm_per_pixel = *mm_per_pixel_;
+      g.radius_factor = std::clamp(g.radius_factor, kFactorLo,
+                                   std::min(kFactorHi, feasibleFactor(*mm_per_pixel_)));
+    } else {
+      g.radius_factor = std::clamp(g.radius_factor, kFactorLo, kFactorHi);
+      g.mm_per_pixel = std::clamp(g.mm_per_pixel, scale_lo_,
+                                  std::min(scale_hi_, feasibleScale(g.radius_factor)));
+    }
+    if (g.mm_per_pixel * g.radius_factor * largest_radius_px_ >= 0.99 * ball_radius_mm_) {
+      return std::nullopt;
+    }
+    return fitShadingResponse(model_, *search_, g, ball_radius_mm_, sigma);
+  }
+
+  bool keepIfBetter(const std::optional<ShadingFit>& fit) {
+    if (!fit || fit->variance_explained <= best_.variance_explained) return false;
+    best_ = *fit;
+    return true;
+  }
+
+  SensorModel model_;
+  double ball_radius_mm_;
+  std::optional<double> mm_per_pixel_;
+  const PressObservation* largest_ = nullptr;
+  double largest_radius_px_ = 0.0;
+  double scale_lo_ = 0.0, scale_hi_ = 0.0;
+  bool use_subset_ = false;
+  std::vector<PressObservation> subset_;
+  const std::vector<PressObservation>* search_ = nullptr;
+  ShadingFit best_;
+};
+
+}  // namespace
+
 ShadingFit fitShadingAndGeometry(const SensorModel& base,
                                  const std::vector<PressObservation>& presses,
                                  double ball_radius_mm, std::optional<double> mm_per_pixel,
                                  std::optional<PressGeometry> start) {
   if (presses.empty()) throw Error("fitShadingAndGeometry: no presses");
-  const PressObservation* largest = &presses.front();
-  for (const PressObservation& p : presses) {
-    if (p.circle.radius_px > largest->circle.radius_px) largest = &p;
-  }
-  const double largest_radius_px = largest->circle.radius_px;
-  const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
-  const double scale_lo = kMinSearchedScale * qvga, scale_hi = kMaxSearchedScale * qvga;
-  const double factor_lo = 0.6, factor_hi = 1.3;
-  // Largest scale at which every contact (radius x factor) still fits the ball.
-  const auto feasibleScale = [&](double factor) {
-    return 0.97 * ball_radius_mm / (factor * largest_radius_px);
-  };
-  // Largest radius factor at which every contact still fits the ball at a given scale.
-  const auto feasibleFactor = [&](double scale) {
-    return 0.97 * ball_radius_mm / (scale * largest_radius_px);
-  };
-  // A given scale is used as given, never changed: the radius factor is held to what the ball
-  // can make at it, and where not even the smallest factor fits, the scale is refused.
-  if (mm_per_pixel && feasibleFactor(*mm_per_pixel) < factor_lo) {
-    std::ostringstream message;
-    message << std::setprecision(4) << "mm per pixel " << *mm_per_pixel << " refused: press '"
-            << largest->name << "' has a contact circle of radius " << largest_radius_px << " px, "
-            << largest_radius_px * *mm_per_pixel << " mm at that scale; even " << factor_lo
-            << " of it (the least the fit takes a detected radius to be) is wider than a ball of "
-            << "radius " << ball_radius_mm << " mm (diameter " << 2.0 * ball_radius_mm
-            << " mm) can make; check --ball-diameter-mm and --mm-per-pixel (or leave the scale "
-            << "out to fit it)";
-    throw Error(message.str());
-  }
-  if (!mm_per_pixel && feasibleScale(factor_lo) < scale_lo) {
-    std::ostringstream message;
-    message << "the largest press (contact radius " << largest_radius_px
-            << " px) is wider than a ball of diameter " << 2.0 * ball_radius_mm
-            << " mm can make at any plausible scale (>= " << scale_lo
-            << " mm/px); check --ball-diameter-mm";
-    throw Error(message.str());
-  }
-
+  GeometrySearch search(base, presses, ball_radius_mm, mm_per_pixel);
+  search.checkTheBallCanMakeThePresses();
   const double default_sigma = makeDigitSensorModel().shading.shadow_sigma_mm;
-  ShadingFit best;
-  best.variance_explained = -1e300;
-  // Searching the scale renders every press for each candidate: with many presses, search on
-  // an evenly spread subset of kMaxSearchPresses, then fit the response on all of them.
-  std::vector<PressObservation> subset;
-  const bool use_subset = !mm_per_pixel && presses.size() > kMaxSearchPresses;
-  if (use_subset) {
-    for (size_t i = 0; i < kMaxSearchPresses; ++i) {
-      subset.push_back(presses[i * presses.size() / kMaxSearchPresses]);
-    }
+  const double scale_ratio = search.scaleRatio();
+  // From a start (a refit), around it; else the coarse grid first.
+  ScaleSearch scale_search;
+  if (start) {
+    search.tryGeometry(*start, default_sigma);
+  } else {
+    scale_search = search.coarseGrid(default_sigma);
   }
-  const std::vector<PressObservation>& search = use_subset ? subset : presses;
-  SensorModel model = base;
-  // The fit at `g` (clamped to the searched ranges), or nothing where the ball cannot make it.
-  // With a given scale the factor gives way to the ball, never the scale.
-  const auto fitAt = [&](PressGeometry g, double sigma) -> std::optional<ShadingFit> {
-    if (mm_per_pixel) {
-      g.mm_per_pixel = *mm_per_pixel;
-      g.radius_factor = std::clamp(g.radius_factor, factor_lo,
-                                   std::min(factor_hi, feasibleFactor(*mm_per_pixel)));
-    } else {
-      g.radius_factor = std::clamp(g.radius_factor, factor_lo, factor_hi);
-      g.mm_per_pixel =
-          std::clamp(g.mm_per_pixel, scale_lo, std::min(scale_hi, feasibleScale(g.radius_factor)));
-    }
-    if (g.mm_per_pixel * g.radius_factor * largest_radius_px >= 0.99 * ball_radius_mm) {
-      return std::nullopt;
-    }
-    return fitShadingResponse(model, search, g, ball_radius_mm, sigma);
-  };
-  const auto keepIfBetter = [&](const std::optional<ShadingFit>& fit) {
-    if (!fit || fit->variance_explained <= best.variance_explained) return false;
-    best = *fit;
-    return true;
-  };
-  const auto tryGeometry = [&](PressGeometry g, double sigma) {
-    return keepIfBetter(fitAt(g, sigma));
-  };
-
-  // Coarse grid: factor in steps of 0.1, scale log-spaced (12 steps over the range). When the
-  // scale is searched, the best fit at each grid scale is its profile.
-  constexpr int kScaleSteps = 12;
-  const double scale_ratio = std::pow(scale_hi / scale_lo, 1.0 / (kScaleSteps - 1));
-  std::vector<ScaleProfilePoint> profile(kScaleSteps);
-  if (start) tryGeometry(*start, default_sigma);
-  // With a given scale, the grid's factors above the ball's limit are all clamped to it: the
-  // first of them is tried, the rest not.
-  const double factor_top =
-      mm_per_pixel ? std::min(factor_hi, feasibleFactor(*mm_per_pixel)) : factor_hi;
-  for (double factor = factor_lo; !start && factor <= factor_top + 0.1 - 1e-9; factor += 0.1) {
-    const double top = std::min(scale_hi, feasibleScale(factor));
-    for (int i = 0; i < (mm_per_pixel ? 1 : kScaleSteps); ++i) {
-      const double scale = scale_lo * std::pow(scale_ratio, i);
-      if (!mm_per_pixel && scale > top) break;
-      const std::optional<ShadingFit> fit = fitAt({scale, factor}, default_sigma);
-      keepIfBetter(fit);
-      if (fit && (profile[i].mm_per_pixel == 0.0 ||
-                  fit->variance_explained > profile[i].variance_explained)) {
-        profile[i] = {fit->geometry.mm_per_pixel, fit->geometry.radius_factor,
-                      fit->variance_explained};
-      }
-    }
-  }
-  const ScaleSearch scale_search =
-      (start || mm_per_pixel) ? ScaleSearch{} : summariseScaleSearch(std::move(profile));
-  // Local pattern search around the best, halving the steps when nothing improves.
-  double scale_step = start ? std::sqrt(scale_ratio) : scale_ratio;
-  double factor_step = start ? 0.025 : 0.05;
-  for (int iteration = 0; iteration < 10; ++iteration) {
-    const PressGeometry centre = best.geometry;
-    bool improved = false;
-    for (const double factor_move : {-1.0, 0.0, 1.0}) {
-      for (const double scale_move : {-1.0, 0.0, 1.0}) {
-        if (factor_move == 0.0 && scale_move == 0.0) continue;
-        if (mm_per_pixel && scale_move != 0.0) continue;
-        const PressGeometry g{centre.mm_per_pixel * std::pow(scale_step, scale_move),
-                              centre.radius_factor + factor_move * factor_step};
-        improved |= tryGeometry(g, default_sigma);
-      }
-    }
-    if (!improved) {
-      scale_step = std::sqrt(scale_step);
-      factor_step *= 0.5;
-    }
-  }
+  search.patternSearch(10, start ? std::sqrt(scale_ratio) : scale_ratio, start ? 0.025 : 0.05,
+                       default_sigma);
   // The rim-shadow width at the chosen geometry, up to 0.6 mm: wider fits the calibration set
   // barely better (held-out variance explained +0.01) but widens the shaded box, which costs
   // render time. (The gel's own smoothing is not fitted: a wider final blur fits these presses
   // no better, and it would wash out Norm2Tex texture.)
-  for (const double sigma : {0.2, 0.3, 0.45, 0.6}) tryGeometry(best.geometry, sigma);
+  for (const double sigma : {0.2, 0.3, 0.45, 0.6}) {
+    search.tryGeometry(search.best().geometry, sigma);
+  }
   // And the geometry once more with it.
-  factor_step = 0.02;
-  scale_step = std::sqrt(std::sqrt(scale_ratio));
-  for (int iteration = 0; iteration < 6; ++iteration) {
-    const PressGeometry centre = best.geometry;
-    bool improved = false;
-    for (const double factor_move : {-1.0, 0.0, 1.0}) {
-      for (const double scale_move : {-1.0, 0.0, 1.0}) {
-        if ((factor_move == 0.0 && scale_move == 0.0) || (mm_per_pixel && scale_move != 0.0)) {
-          continue;
-        }
-        improved |= tryGeometry({centre.mm_per_pixel * std::pow(scale_step, scale_move),
-                                 centre.radius_factor + factor_move * factor_step},
-                                best.shading.shadow_sigma_mm);
-      }
-    }
-    if (!improved) {
-      scale_step = std::sqrt(scale_step);
-      factor_step *= 0.5;
-    }
-  }
-  const double s = best.geometry.mm_per_pixel;
-  best.scale_at_search_bound =
-      !mm_per_pixel && (s <= scale_lo * 1.01 ||
-                        s >= 0.99 * std::min(scale_hi, feasibleScale(best.geometry.radius_factor)));
-  if (use_subset) {
-    const bool at_bound = best.scale_at_search_bound;
-    best = fitShadingResponse(model, presses, best.geometry, ball_radius_mm,
-                              best.shading.shadow_sigma_mm);
-    best.scale_at_search_bound = at_bound;
-  }
+  search.patternSearch(6, std::sqrt(std::sqrt(scale_ratio)), 0.02, std::nullopt);
+  ShadingFit best = search.result(presses);
   best.scale_search = scale_search;
   return best;
 }
