@@ -418,15 +418,91 @@ def check_figures(page_list, home_text, root=ROOT):
 
 
 # --- the checks over a package ------------------------------------------------------------------
+
+# --- the package's programs and scripts on the pages: their options -----------------------------
+# Options a program takes that its own source does not spell (Google Benchmark's flags).
+_FOREIGN_OPTIONS = {"norm2tex_bench": re.compile(r"^benchmark_\w+$")}
+_WRAPPERS = ("sudo", "time", "exec", "env", "nice", "timeout", "bash", "python3")
+
+
+def program_sources(root, cmake_text):
+    """{program: [source texts]}: scripts/* and every add_executable's .cpp files."""
+    out = {}
+    scripts = os.path.join(root, "scripts")
+    for name in os.listdir(scripts):
+        path = os.path.join(scripts, name)
+        if os.path.isfile(path):
+            out[name] = [read(path)]
+    text = re.sub(r"#.*", "", cmake_text)
+    for m in re.finditer(r"\badd_executable\s*\(\s*(\w+)\s+([^)]*)\)", text):
+        files = [os.path.join(root, w) for w in m.group(2).split() if w.endswith(".cpp")]
+        out[m.group(1)] = [read(f) for f in files if os.path.exists(f)]
+    return out
+
+
+def command_uses(text):
+    """(program, [--options], how it was named) for every command of a code line: `scripts/X`,
+    `rosrun norm2tex X`, or a bare `norm2tex_X`."""
+    uses = []
+    for segment in split_code(text)[1]:
+        for line in segment.split("\n"):
+            for part in re.split(r"\s(?:&&|\|\||;|\|)\s|\$\(|`", _strip_comment(line)):
+                words = part.split()
+                while words and (re.match(r"^\w+=\S*$", words[0]) or words[0] in _WRAPPERS or
+                                 re.match(r"^-", words[0]) or re.match(r"^\d+[smh]?$", words[0])):
+                    words = words[1:]
+                if not words:
+                    continue
+                if words[0] == "rosrun" and len(words) > 2 and words[1] == "norm2tex":
+                    program, rest, named = words[2], words[3:], "rosrun norm2tex " + words[2]
+                elif re.match(r"^(\./|\S*/)?scripts/[\w/-]+$", words[0]):
+                    program = re.sub(r"^(\./|\S*/)?scripts/", "", words[0])
+                    rest, named = words[1:], "scripts/" + program
+                elif re.match(r"^norm2tex_\w+$", words[0]):
+                    program, rest, named = words[0], words[1:], words[0]
+                else:
+                    continue
+                options = [m.group(1) for m in (re.match(r"^--([A-Za-z][\w-]*)", w) for w in rest)
+                           if m and m.group(1) != "help"]
+                uses.append((program, options, named))
+    return uses
+
+
+def check_commands(where, text, sources):
+    """Errors for a page's commands: a program or script that is not there, an option its source
+    does not declare (`--name` in a script, `"name"` in a program's option table)."""
+    errors = []
+    for program, options, named in command_uses(text):
+        if program not in sources:
+            if named.startswith("scripts/") and "/" not in program:
+                errors.append("%s: %s: no such script" % (where, named))
+            elif named.startswith("norm2tex_") and options:
+                # (A bare name without options may be a library or node named in prose:
+                # `norm2tex_core`, `norm2tex_manager`.)
+                errors.append("%s: %s: no such program" % (where, named))
+            continue
+        foreign = _FOREIGN_OPTIONS.get(program)
+        for option in options:
+            if foreign and foreign.match(option):
+                continue
+            spelled = ("--" + option, '"%s"' % option, '"%s,' % option)
+            if not any(any(s in src for s in spelled) for src in sources[program]):
+                errors.append("%s: %s --%s: not an option of %s" % (where, named, option, program))
+    return errors
+
+
 def check_package(root=ROOT, page_list=None):
     """Every problem found, as one-line messages."""
     page_list = pages(root) if page_list is None else page_list
     errors = []
-    programs = installed_programs(read(os.path.join(root, "CMakeLists.txt")))
+    cmake_text = read(os.path.join(root, "CMakeLists.txt"))
+    programs = installed_programs(cmake_text)
+    sources = program_sources(root, cmake_text)
     nodelets = exported_nodelets(os.path.join(root, "nodelet_plugins.xml"))
     for path, text in page_list:
         where = os.path.relpath(path, root)
         errors += check_links(path, text, root)
+        errors += check_commands(where, text, sources)
         for launch, args in roslaunch_uses(text):
             launch_path = os.path.join(root, "launch", launch)
             if not os.path.exists(launch_path):
@@ -549,6 +625,19 @@ class CheckerCatchesBrokenPages(unittest.TestCase):
         errors = self.broken("```bash\nrosrun norm2tex quickstart run\n"
                              "rosrun norm2tex norm2tex_frobnicate\n```\n")
         self.assertEqual(len(errors), 2, errors)
+
+    def test_programs_scripts_and_their_options(self):
+        errors = self.broken("```bash\nscripts/record_dataset /tmp/x material:=wood\n"
+                             "scripts/texture_contrast --forces 2,5 --figure x.png\n"
+                             "scripts/record_datasets /tmp/x\n"
+                             "norm2tex_render --mesh box:30x30x30 --colour red\n"
+                             "rosrun norm2tex norm2tex_bake in.png -o out.tiff --speed fast\n"
+                             "norm2tex_bench --benchmark_filter=Render\nnorm2tex_frobnicate --all\n```\n")
+        self.assertEqual(len(errors), 4, errors)
+        self.assertTrue(any("scripts/record_datasets: no such script" in e for e in errors))
+        self.assertTrue(any("--colour: not an option of norm2tex_render" in e for e in errors))
+        self.assertTrue(any("--speed: not an option of norm2tex_bake" in e for e in errors))
+        self.assertTrue(any("norm2tex_frobnicate: no such program" in e for e in errors))
 
     def test_unknown_nodelet(self):
         self.assertEqual(len(self.broken("`norm2tex/FooNodelet`\n")), 1)
