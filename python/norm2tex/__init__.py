@@ -37,6 +37,7 @@ _CORE_NAMES = (
     "read_image",
     "block_mean",
     "calibrate_sensor",
+    "measure_ridge_contrast",
     "TactileRenderer",
     "GripperOptions",
     "ObjectOptions",

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "norm2tex/calibrate/ridge_contrast.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include <opencv2/imgcodecs.hpp>
 
@@ -327,6 +328,34 @@ void bindRender(py::module& m) {
       "cols, 3)), minus the background's when given; rows and cols past the last whole block are "
       "dropped. Equals numpy's blocks.mean(axis=(2, 4), dtype=float32) of the same crop, ~20x "
       "faster: what the environments' downscale and diff images are made with.");
+
+  m.def(
+      "measure_ridge_contrast",
+      [](const py::handle& frame, const py::handle& background, std::array<int, 4> box,
+         std::optional<std::array<int, 4>> noise_box, double fine_sigma_px,
+         double coarse_sigma_px, double normal_angle_rad) {
+        RidgeContrastOptions options;
+        options.fine_sigma_px = fine_sigma_px;
+        options.coarse_sigma_px = coarse_sigma_px;
+        options.normal_angle_rad = normal_angle_rad;
+        const auto rect = [](const std::array<int, 4>& r) { return cv::Rect(r[0], r[1], r[2], r[3]); };
+        const RidgeContrast c = measureRidgeContrast(
+            cv::Mat3b(fromNumpy(frame, CV_8UC3, "frame")),
+            cv::Mat3b(fromNumpy(background, CV_8UC3, "background")), rect(box),
+            noise_box ? rect(*noise_box) : cv::Rect(), options);
+        py::dict out;
+        out["raw"] = c.raw;
+        out["noise"] = c.noise;
+        out["contrast"] = c.contrast;
+        return out;
+      },
+      py::arg("frame"), py::arg("background"), py::arg("box"), py::arg("noise_box") = py::none(),
+      py::arg("fine_sigma_px") = 1.5, py::arg("coarse_sigma_px") = 6.0,
+      py::arg("normal_angle_rad") = 0.0,
+      "The ridges' contrast of a bgr8 frame against its background (grey levels): the RMS in box "
+      "(x, y, width, height) of a difference of Gaussians across the ridges (sigmas in px, along "
+      "the normal at normal_angle_rad from +x towards +y), B, G, R in quadrature, less the same "
+      "in noise_box (outside the contact) in quadrature: dict raw, noise, contrast.");
 
   m.def(
       "calibrate_sensor",

@@ -305,3 +305,19 @@ def test_a_batch_step_applies_each_mode_as_named(sensor):
     assert after[2] == before[2]
     with pytest.raises(ValueError, match="command mode 3; valid: 0 ABSOLUTE, 1 DELTA, 2 KEEP"):
         batch.step([3, KEEP, KEEP], [0.0, 0.0, 0.0])
+
+
+def test_ridge_contrast_of_a_sinusoid_is_its_band_gain():
+    # Vertical ridges 11 px apart, amplitude 10 on every channel: the difference of Gaussians
+    # (1.5 and 6 px) passes exp(-(1.5 k)^2 / 2) - exp(-(6 k)^2 / 2) of it, B, G, R in quadrature.
+    x = np.arange(320)
+    ridges = 100.0 + 10.0 * np.sin(2.0 * math.pi * x / 11.0)
+    frame = np.repeat(np.tile(ridges, (240, 1))[:, :, None], 3, axis=2).round().astype(np.uint8)
+    background = np.full((240, 320, 3), 100, np.uint8)
+    k = 2.0 * math.pi / 11.0
+    gain = math.exp(-0.5 * (1.5 * k) ** 2) - math.exp(-0.5 * (6.0 * k) ** 2)
+    c = norm2tex.measure_ridge_contrast(frame, background, (120, 88, 80, 65))
+    assert c["raw"] == pytest.approx(math.sqrt(3.0) * 10.0 * gain / math.sqrt(2.0), rel=0.04)
+    assert c["contrast"] == c["raw"] and c["noise"] == 0.0
+    with pytest.raises(norm2tex.Error, match="not inside"):
+        norm2tex.measure_ridge_contrast(frame, background, (300, 200, 80, 65))
