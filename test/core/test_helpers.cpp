@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
 
 #include "norm2tex/texture/normal_encoding.hpp"
 
@@ -52,6 +53,25 @@ NormalMap quantisedNormalMap(const AnalyticSurface& surface, const cv::Mat1b& ma
   NormalMapOptions options;
   options.convention = convention;
   return NormalMap::fromImage(image, options, mask);
+}
+
+TexturedMesh makeHelicoidRamp() {
+  const double pi = 3.14159265358979323846;
+  std::vector<Eigen::Vector3f> vertices;
+  std::vector<Eigen::Vector3i> triangles;
+  const int steps = 90;
+  for (int i = 0; i <= steps; ++i) {
+    const double a = 3.0 * pi * i / steps, z = 0.001 * i / steps;
+    for (double radius : {0.005, 0.01}) {
+      vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
+    }
+  }
+  for (int i = 0; i < steps; ++i) {
+    const int a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
+    triangles.emplace_back(a, b, d);
+    triangles.emplace_back(a, d, c);
+  }
+  return TexturedMesh(vertices, triangles);
 }
 
 ScratchDirectory::ScratchDirectory() {

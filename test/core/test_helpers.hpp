@@ -11,6 +11,7 @@
 
 #include "norm2tex/texture/analytic_surface.hpp"
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/mesh/textured_mesh.hpp"
 #include "norm2tex/texture/normal_map.hpp"
 
 namespace norm2tex {
@@ -30,6 +31,11 @@ double maskedStdDev(const cv::Mat1f& a, const cv::Mat1b& mask);
 /// again, the way a normal map file would arrive.
 NormalMap quantisedNormalMap(const AnalyticSurface& surface, const cv::Mat1b& mask, int depth,
                              NormalConvention convention = NormalConvention::kOpenGL);
+
+/// A ramp winding 1.5 turns around z (radii 5 and 10 mm, 1 mm rise, 90 steps of two triangles):
+/// every face looks up (one class, one component), but its projection onto the ground plane
+/// covers itself, so unwrapUvs must cut it.
+TexturedMesh makeHelicoidRamp();
 
 /// Expects `code` to throw norm2tex::Error with a one-line message containing every one of
 /// `parts` (a file name, a parameter, the valid choices...).

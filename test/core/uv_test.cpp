@@ -374,23 +374,8 @@ TEST(UnwrapUvs, TorusCharts) {
 }
 
 TEST(UnwrapUvs, HelicoidRampIsSplitWhereItWouldOverlap) {
-  // A ramp winding 1.5 turns: every face looks up (one class, one component), but its
-  // projection onto the ground plane covers itself; unwrapUvs must cut it.
-  std::vector<Eigen::Vector3f> vertices;
-  std::vector<Eigen::Vector3i> triangles;
-  const int steps = 90;
-  for (int i = 0; i <= steps; ++i) {
-    const double a = 3.0 * kPi * i / steps, z = 0.001 * i / steps;
-    for (double radius : {0.005, 0.01}) {
-      vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
-    }
-  }
-  for (int i = 0; i < steps; ++i) {
-    const int a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
-    triangles.emplace_back(a, b, d);
-    triangles.emplace_back(a, d, c);
-  }
-  const TexturedMesh ramp(vertices, triangles);
+  // A ramp winding 1.5 turns: every face looks up, but its projection covers itself.
+  const TexturedMesh ramp = test::makeHelicoidRamp();
   UnwrapOptions options;
   options.texture_size = 512;
   options.padding_texels = 2;
