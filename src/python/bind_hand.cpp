@@ -288,21 +288,10 @@ void bindHand(py::module& m) {
         return py::make_tuple(s.collision().kind, s.collision().parts);
       }, "(kind, convex parts) the object collides as");
 
-  py::class_<TactileHandOptions>(
+  py::class_<TactileHandOptions> hand_options(
       m, "TactileHandOptions",
-      "How a TactileHand runs: TactileGripperOptions' fields but the episode's, same meanings.")
-      .def(py::init<>())
-      .def_readwrite("frame_rate_hz", &TactileHandOptions::frame_rate_hz)
-      .def_readwrite("physics_rate_hz", &TactileHandOptions::physics_rate_hz)
-      .def_readwrite("material_config", &TactileHandOptions::material_config,
-                     "config/materials/<name>.yaml; '' = no material")
-      .def_readwrite("variant", &TactileHandOptions::variant)
-      .def_readwrite("material_seed", &TactileHandOptions::material_seed)
-      .def_readwrite("beta_mm", &TactileHandOptions::beta_mm, "< 0: the material's; 0: none")
-      .def_readwrite("friction", &TactileHandOptions::friction, "< 0: the material's")
-      .def_readwrite("noise_seed", &TactileHandOptions::noise_seed, "< 0: no noise")
-      .def_readwrite("noise_per_episode", &TactileHandOptions::noise_per_episode,
-                     "count the noise's frames from each reset (else from construction)")
+      "How a TactileHand runs: TactileGripperOptions' fields but the episode's, same meanings.");
+  bindTactileOptions(hand_options)
       .def_readwrite("render_threads", &TactileHandOptions::render_threads,
                      "threads the sensors render on (the same frames whatever the count): 1 one "
                      "after another, 0 one per core");

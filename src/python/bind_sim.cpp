@@ -196,21 +196,10 @@ void bindSim(py::module& m) {
         return py::make_tuple(s.collision().kind, s.collision().parts);
       }, "(kind, convex parts) the object collides as");
 
-  py::class_<TactileGripperOptions>(
+  py::class_<TactileGripperOptions> gripper_options(
       m, "TactileGripperOptions",
-      "How a TactileGripper runs: contact_sim's and tactile_renderer's parameters, same defaults.")
-      .def(py::init<>())
-      .def_readwrite("frame_rate_hz", &TactileGripperOptions::frame_rate_hz)
-      .def_readwrite("physics_rate_hz", &TactileGripperOptions::physics_rate_hz)
-      .def_readwrite("material_config", &TactileGripperOptions::material_config,
-                     "config/materials/<name>.yaml; '' = no material")
-      .def_readwrite("variant", &TactileGripperOptions::variant)
-      .def_readwrite("material_seed", &TactileGripperOptions::material_seed)
-      .def_readwrite("beta_mm", &TactileGripperOptions::beta_mm, "< 0: the material's; 0: none")
-      .def_readwrite("friction", &TactileGripperOptions::friction, "< 0: the material's")
-      .def_readwrite("noise_seed", &TactileGripperOptions::noise_seed, "< 0: no noise")
-      .def_readwrite("noise_per_episode", &TactileGripperOptions::noise_per_episode,
-                     "count the noise's frames from each reset (else from construction, as ROS)")
+      "How a TactileGripper runs: contact_sim's and tactile_renderer's parameters, same defaults.");
+  bindTactileOptions(gripper_options)
       .def_readwrite("seed", &TactileGripperOptions::seed, "the first episode's seed")
       .def_readwrite("height_offset_m", &TactileGripperOptions::height_offset_m,
                      "the first episode's offset (NaN: drawn)");
