@@ -101,6 +101,12 @@ void bindRender(py::module& m) {
           [](const SensorModel& s) { return s.conformity.contact_modulus_mpa; },
           [](SensorModel& s, double e) { s.conformity.contact_modulus_mpa = e; },
           "the gel's contact modulus E*, MPa (the conformity model's)")
+      .def_property(
+          "coating_length_mm",
+          [](const SensorModel& s) { return s.conformity.coating_length_mm; },
+          [](SensorModel& s, double l) { s.conformity.coating_length_mm = l; },
+          "the coating's bending length, mm: relief of wavelength L needs (1 + (2 pi l / L)^3) "
+          "times Johnson's pressure (0: no coating)")
       .def_readwrite("background_image", &SensorModel::background_image,
                      "no-contact frame (bgr image file); empty: the synthetic background")
       .def_property_readonly(

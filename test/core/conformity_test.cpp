@@ -42,7 +42,7 @@ double fullContactPressureMpa() {
   return CV_PI * kModulusMpa * kAmplitudeMm / (kWavelengthPx * kMmPerPixel);
 }
 
-SinusoidPress pressSinusoid(double pressure_ratio) {
+SinusoidPress pressSinusoid(double pressure_ratio, double coating_length_mm = 0.0) {
   SinusoidPress press;
   press.relief.create(kRows, kCols);
   for (int r = 0; r < kRows; ++r) {
@@ -57,6 +57,7 @@ SinusoidPress pressSinusoid(double pressure_ratio) {
   ConformityOptions options;
   options.enabled = true;
   options.contact_modulus_mpa = kModulusMpa;
+  options.coating_length_mm = coating_length_mm;
   GelConformity conformity(options, kMmPerPixel);
   press.stats = conformity.apply(indentation, press.relief, 1.0, cv::Rect(0, 0, kCols, kRows),
                                  force_n, press.followed);
@@ -117,6 +118,31 @@ TEST(GelConformity, SinusoidIsFollowedFromItsCrestsAsJohnsonSays) {
     EXPECT_NEAR(renderedAmplitudeMm(press), kAmplitudeMm, 0.05 * kAmplitudeMm) << ratio;
     EXPECT_LT(cv::norm(press.followed, press.relief, cv::NORM_INF), 5e-3 * kAmplitudeMm) << ratio;
   }
+}
+
+TEST(GelConformity, ACoatingRaisesTheFullContactPressureAsAPlateOnTheGel) {
+  // A plate of bending length l on the half-space: p* grows by (1 + (2 pi l / lambda)^3), here
+  // 1 + (2 pi 0.5 / 2)^3 = 4.9 for the 2 mm sinusoid; the same pressure follows less of it.
+  const double l = 0.5, lambda = kWavelengthPx * kMmPerPixel;
+  const double stiffening = 1.0 + std::pow(2.0 * CV_PI * l / lambda, 3);
+  const SinusoidPress coated = pressSinusoid(0.5 * stiffening, l);
+  bool checked = false;
+  for (const ConformityBand& band : coated.stats.bands) {
+    if (band.amplitude_mm == 0.0) continue;
+    checked = true;
+    EXPECT_NEAR(band.full_contact_pressure_mpa, stiffening * fullContactPressureMpa(),
+                0.01 * stiffening * fullContactPressureMpa());
+  }
+  EXPECT_TRUE(checked);
+  // At 4.9 times the pressure the bare gel needs for half the relief, the coated one follows
+  // half of it too; at the bare gel's pressure, a fifth.
+  EXPECT_NEAR(renderedAmplitudeMm(coated), renderedAmplitudeMm(pressSinusoid(0.5)),
+              0.03 * kAmplitudeMm);
+  EXPECT_NEAR(renderedAmplitudeMm(pressSinusoid(0.5, l)),
+              renderedAmplitudeMm(pressSinusoid(0.5)) / stiffening, 0.01 * kAmplitudeMm);
+  // Without a coating the relief is Johnson's, bit for bit.
+  const SinusoidPress bare = pressSinusoid(0.5), zero = pressSinusoid(0.5, 0.0);
+  EXPECT_EQ(cv::norm(bare.followed, zero.followed, cv::NORM_INF), 0.0);
 }
 
 TEST(GelConformity, ContactPatchesHaveJohnsonsWidth) {

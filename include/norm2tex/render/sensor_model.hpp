@@ -73,6 +73,12 @@ struct ConformityOptions {
   /// GelSight table) read as a flat face pressing the gel pad, E = F h / (A d), gives
   /// 0.05-0.16 MPa over 0.1-2 mm of indentation (0.08-0.10 over the measured 0.4-0.58 mm).
   double contact_modulus_mpa = 0.1;
+  /// The gel's coating as a thin plate on it, by its bending length l = (2 D / E*)^(1/3), mm
+  /// (D the coating's bending stiffness): a plate on an elastic half-space needs
+  /// (E* k / 2 + D k^4) w of pressure to bend into relief of wavenumber k and amplitude w, so it
+  /// follows relief of wavelength lambda only at (1 + (2 pi l / lambda)^3) times Johnson's p*:
+  /// short wavelengths are filtered, coarse relief is not. 0: no coating (Johnson's half-space).
+  double coating_length_mm = 0.0;
 };
 
 /// Everything about one DIGIT that the renderer needs, loaded from config/digit.yaml.

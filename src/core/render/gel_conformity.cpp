@@ -297,7 +297,7 @@ void bandStatistics(Pass& pass, ConformityStats& stats) {
 //    level = crest - 2 A p / p* with p = pressure_per_mm h: the band's lowest value at p*,
 //    and lower still beyond (nothing clipped); -inf for a flat band.
 void clipLevels(Pass& pass, const std::vector<float>& sample_depths, double contact_modulus_mpa,
-                double mm_per_pixel, ConformityStats& stats) {
+                double coating_length_mm, double mm_per_pixel, ConformityStats& stats) {
   const long samples = pass.samples;
   for (int k = 0; k < kBands; ++k) {
     const BandSums& s = pass.sums[k];
@@ -319,8 +319,11 @@ void clipLevels(Pass& pass, const std::vector<float>& sample_depths, double cont
     const double wavenumber_per_mm = std::sqrt(wx * wx + wy * wy) / mm_per_pixel;
     if (!(wavenumber_per_mm > 0.0)) continue;
     out.wavelength_mm = 2.0 * kPi / wavenumber_per_mm;
+    // A coating over the gel bends into short wavelengths only at a higher pressure (a plate on
+    // an elastic half-space; exactly 1 without one, so the frames are Johnson's).
+    const double coating = 1.0 + std::pow(2.0 * kPi * coating_length_mm / out.wavelength_mm, 3);
     out.full_contact_pressure_mpa =
-        kPi * contact_modulus_mpa * stats.relief_amplitude_mm / out.wavelength_mm;
+        kPi * (contact_modulus_mpa * coating) * stats.relief_amplitude_mm / out.wavelength_mm;
     pass.crest[k] = static_cast<float>(s.max);
     pass.full_sink[k] = static_cast<float>(4.0 * out.amplitude_mm);  // see step 6
     pass.sink_per_mm[k] = static_cast<float>(2.0 * out.amplitude_mm * pass.pressure_per_mm /
@@ -461,7 +464,8 @@ ConformityStats GelConformity::run(const cv::Mat1f& h_sensor_mm, const cv::Mat1f
   buildPyramid(h_local(box), beta_mm, smoothed_, half_, up_, pass);
   sampleContact(pass, sample_offsets_, sample_depths_);
   bandStatistics(pass, stats);
-  clipLevels(pass, sample_depths_, options_.contact_modulus_mpa, mm_per_pixel_, stats);
+  clipLevels(pass, sample_depths_, options_.contact_modulus_mpa, options_.coating_length_mm,
+             mm_per_pixel_, stats);
   tabulateRise(pass, rise_table_);
   writeFollowed(pass, smoothed_, rise_table_, zeros_, gap_mm, thickness_mm, out_mm);
   return stats;

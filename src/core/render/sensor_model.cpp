@@ -46,7 +46,7 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
        {"sigma_bgr", "neighbour_correlation", "correlation_bg", "correlation_gr", "correlation_br",
         "on_real_background"}},
       {"gel_model", {"pyramid_sigmas_mm", "core_fraction", "final_sigma_mm"}},
-      {"conformity", {"enabled", "contact_modulus_mpa"}},
+      {"conformity", {"enabled", "contact_modulus_mpa", "coating_length_mm"}},
   };
   return keys.at(section);
 }
@@ -218,6 +218,8 @@ void validate(const SensorModel& m) {
   requireParameter(m.conformity.contact_modulus_mpa > 0.0 && m.conformity.contact_modulus_mpa <= 100.0,
                    "conformity.contact_modulus_mpa", m.conformity.contact_modulus_mpa,
                    "(0, 100] MPa");
+  requireParameter(m.conformity.coating_length_mm >= 0.0 && m.conformity.coating_length_mm <= 2.0,
+                   "conformity.coating_length_mm", m.conformity.coating_length_mm, "[0, 2] mm");
 }
 
 SensorModel loadSensorModel(const std::string& yaml_path) {
@@ -275,6 +277,7 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
       rejectUnknownKeys(conformity, "conformity");
       read(conformity, "enabled", m.conformity.enabled);
       read(conformity, "contact_modulus_mpa", m.conformity.contact_modulus_mpa);
+      read(conformity, "coating_length_mm", m.conformity.coating_length_mm);
     }
     if (!m.background_image.empty() && std::filesystem::path(m.background_image).is_relative()) {
       m.background_image =
@@ -343,7 +346,8 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
   out << "]\n  core_fraction: " << m.gel.core_fraction
       << "\n  final_sigma_mm: " << m.gel.final_sigma_mm << "\n"
       << "conformity:\n  enabled: " << (m.conformity.enabled ? "true" : "false")
-      << "\n  contact_modulus_mpa: " << m.conformity.contact_modulus_mpa << "\n";
+      << "\n  contact_modulus_mpa: " << m.conformity.contact_modulus_mpa
+      << "\n  coating_length_mm: " << m.conformity.coating_length_mm << "\n";
   std::ofstream file(yaml_path);
   file << out.str();
   file.close();
