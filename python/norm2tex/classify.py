@@ -22,6 +22,8 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from norm2tex.blocks import CHANNELS_FIRST, block_mean
+
 ARCHS = ("small", "resnet18")
 DOWNSCALES = (1, 2, 4)
 # The diff frames are grey-level differences of a few tens; this brings them near unit scale.
@@ -29,7 +31,8 @@ INPUT_SCALE = 32.0
 
 
 class Downscale(nn.Module):
-    """Scales the diff frame to ~unit values and averages it over factor x factor blocks."""
+    """Scales the diff frame to ~unit values and averages it over factor x factor blocks
+    (norm2tex.block_mean: rows and columns past the last whole block are dropped)."""
 
     def __init__(self, factor):
         super().__init__()
@@ -38,8 +41,7 @@ class Downscale(nn.Module):
         self.factor = factor
 
     def forward(self, x):
-        x = x / INPUT_SCALE
-        return F.avg_pool2d(x, self.factor) if self.factor > 1 else x
+        return block_mean(x / INPUT_SCALE, self.factor, axes=CHANNELS_FIRST)
 
 
 class SmallTactileNet(nn.Module):
