@@ -23,6 +23,7 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 from norm2tex.blocks import CHANNELS_FIRST, block_mean
+from norm2tex.torch_device import resolve_device
 
 ARCHS = ("small", "resnet18")
 DOWNSCALES = (1, 2, 4)
@@ -139,18 +140,6 @@ def build_model(arch, classes, downscale=4, channels=3):
     raise ValueError(f"unknown arch {arch!r}: choose one of {', '.join(ARCHS)}")
 
 
-def resolve_device(device):
-    """"auto" -> "cuda" when PyTorch sees a GPU, else "cpu"; "cuda" without one is an error."""
-    if device == "auto":
-        return "cuda" if torch.cuda.is_available() else "cpu"
-    if device == "cuda" and not torch.cuda.is_available():
-        raise RuntimeError("--device cuda, but PyTorch sees no CUDA GPU (torch.cuda.is_available()"
-                           " is False); use --device cpu or auto")
-    if device not in ("cpu", "cuda"):
-        raise ValueError(f"device must be auto, cpu or cuda, not {device!r}")
-    return device
-
-
 def split(export_dir, test_variants):
     """(train, test, classes): ExportedDataset of the variants not held out and of the held-out
     ones. Raises ValueError when no frame is held out or no variant is left to train on."""
@@ -202,12 +191,13 @@ def run(export_dir, test_variants=(3,), epochs=12, seed=0, downscale=4, arch="sm
         raise ValueError(f"unknown arch {arch!r}: choose one of {', '.join(ARCHS)}")
     if downscale not in DOWNSCALES:
         raise ValueError(f"downscale must be one of {DOWNSCALES}, not {downscale!r}")
-    device = resolve_device(device)
+    device = resolve_device(device)  # "auto": cuda when PyTorch sees a GPU, else cpu
     if threads:
         torch.set_num_threads(threads)
     torch.manual_seed(seed)
     use_deterministic_kernels()
-    if device == "cuda":
+    on_gpu = device.startswith("cuda")
+    if on_gpu:
         torch.backends.cudnn.benchmark = False
     train, test, classes = split(export_dir, test_variants)
     train_variants = sorted({r["variant"] for r in train.rows})
@@ -215,12 +205,11 @@ def run(export_dir, test_variants=(3,), epochs=12, seed=0, downscale=4, arch="sm
     log(f"{len(train)} training frames (variants {train_variants}), {len(test)} held-out "
         f"(variants {held_out}); classes {classes}; {arch}, {downscale}x averaging, {device}")
     order = torch.Generator().manual_seed(seed)
-    pin = device == "cuda"
     train_loader = torch.utils.data.DataLoader(train, batch_size=batch_size, shuffle=True,
                                                generator=order, num_workers=workers,
-                                               pin_memory=pin)
+                                               pin_memory=on_gpu)
     test_loader = torch.utils.data.DataLoader(test, batch_size=64, num_workers=workers,
-                                              pin_memory=pin)
+                                              pin_memory=on_gpu)
     model = build_model(arch, len(classes), downscale).to(device)
     optimiser = torch.optim.Adam(model.parameters(), lr=lr)
     history = []

@@ -1,6 +1,6 @@
 """scripts/hold_cube_experiment (norm2tex.rl.hold_cube_experiment): the quick run end to end
 with every output, its numbers in range, the same numbers for the same seed; the environments it
-needs: a batch with one material per environment, and the empty gripper."""
+needs: a batch with one material per environment, and the empty gripper; its device rule."""
 
 import csv
 import json
@@ -17,6 +17,7 @@ torch = pytest.importorskip("torch", reason="PyTorch is not installed (Debian: p
 import norm2tex  # noqa: E402
 from norm2tex.envs import HoldCubeEnv, HoldCubeVectorEnv, hold_reward  # noqa: E402
 from norm2tex.rl import hold_cube_experiment as hce  # noqa: E402
+from norm2tex.torch_device import DeviceUnavailable, resolve_device  # noqa: E402
 
 MATERIALS = ["wood", "fabric", "smooth"]
 
@@ -203,3 +204,13 @@ def test_sb3_is_refused_clearly_when_missing(tmp_path):
         pass
     with pytest.raises(RuntimeError, match="stable_baselines3"):
         hce.run(replace(hce.quick_config(), algo="sb3"), str(tmp_path), log=lambda line: None)
+
+
+def test_a_device_that_is_not_there_stops_the_run_before_it_starts(tmp_path):
+    assert hce.resolve_device is resolve_device  # the package's one rule
+    if torch.cuda.is_available():
+        pytest.skip("PyTorch sees a GPU here")
+    with pytest.raises(DeviceUnavailable, match="'cuda' was asked for"):
+        hce.run(replace(hce.quick_config(), device="cuda"), str(tmp_path / "out"),
+                log=lambda line: None)
+    assert not (tmp_path / "out").exists()

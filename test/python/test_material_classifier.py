@@ -2,7 +2,8 @@
 that differ only by stripes of a 2-pixel period. At full resolution the classifier learns
 them; averaged 2x or 4x it cannot (the average of a 2-px period over 2 or 4 pixels is exactly
 zero), which is what --downscale decides about real textures. Also ResNet-18's shape, size
-and one training step, the JSON's keys, the same seed's same result, and the errors."""
+and one training step, the JSON's keys, the same seed's same result, and the errors (an
+unavailable --device among them)."""
 
 import csv
 import json
@@ -163,11 +164,20 @@ def test_json_has_every_number(export, tmp_path):
     (["--test-variants", "7"], "no frames of the held-out variants [7]"),
     (["--test-variants", "0,1,2"], "no variant left to train on"),
     (["--arch", "vgg"], "unknown --arch 'vgg'"),
+    (["--device", "gpu"], "device 'gpu' is not a device name: auto, cpu, cuda or cuda:N"),
 ])
 def test_clear_errors(export, args, message):
     ran = run_script(export, "--epochs", "1", "--workers", "0", *args)
     assert ran.returncode != 0
     assert message in ran.stderr, ran.stderr
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="PyTorch sees a GPU here")
+def test_a_device_that_is_not_there_is_an_error_not_a_cpu_run(export):
+    ran = run_script(export, "--epochs", "1", "--workers", "0", "--device", "cuda")
+    assert ran.returncode != 0 and "held-out confusion" not in ran.stdout
+    assert "'cuda' was asked for, but PyTorch sees no CUDA GPU" in ran.stderr, ran.stderr
+    assert "available: cpu" in ran.stderr, ran.stderr
 
 
 def test_errors_of_the_module(export):

@@ -56,6 +56,7 @@ from torch import nn
 from norm2tex.envs import HoldCubeVectorEnv, drop_threshold
 from norm2tex.envs.hold_cube import HORIZON
 from norm2tex.rl import ppo
+from norm2tex.torch_device import resolve_device
 
 CONDITIONS = ("blind", "textureless", "norm2tex")
 MATERIALS = ("wood", "fabric", "smooth")
@@ -95,7 +96,7 @@ class ExperimentConfig:
     # drop_threshold's openings (None: its default, 0.45-0.70 in steps of 0.0025).
     threshold_openings: tuple = None
     threads: int = 0                   # the simulator's C++ threads (0: every core)
-    device: str = None                 # None: cuda if available, else cpu
+    device: str = None                 # None or "auto": cuda if available, else cpu
     extra: dict = field(default_factory=dict)
 
 
@@ -110,10 +111,10 @@ def quick_config(**overrides):
     return replace(config, **overrides)
 
 
-def resolve_device(device=None):
-    """cuda when available (or asked), else cpu with torch using every core."""
-    if device is None:
-        device = "cuda" if torch.cuda.is_available() else "cpu"
+def use_device(device=None):
+    """resolve_device(device) (an unavailable device is an error); on the CPU torch then uses
+    every core: the simulator and the networks take turns, so each may have them all."""
+    device = resolve_device(device)
     if device == "cpu":
         torch.set_num_threads(os.cpu_count() or 1)
     return device
@@ -252,7 +253,7 @@ def _ppo_config(config):
 def train_condition(condition, config, log=print):
     """Trains one policy with norm2tex.rl.ppo; returns (act, records, policy). act(obs) ->
     greedy actions for a batch of observations. log(record) per update."""
-    device = resolve_device(config.device)
+    device = use_device(config.device)
     env = make_env(condition, config, config.materials, config.train_variants, config.num_envs)
     try:
         torch.manual_seed(config.seed)
@@ -327,7 +328,7 @@ def train_condition_sb3(condition, config, log=print):
         def forward(self, obs):
             return self.encoder(obs)
 
-    device = resolve_device(config.device)
+    device = use_device(config.device)
     model = PPO("MultiInputPolicy", venv, n_steps=config.rollout_steps,
                 batch_size=config.rollout_steps * config.num_envs // config.minibatches,
                 n_epochs=config.update_epochs, learning_rate=config.learning_rate,
@@ -693,8 +694,8 @@ def run(config=None, out_dir="hold_cube_experiment", log=print):
         raise ValueError("encoder %r; valid: %s" % (config.encoder, ", ".join(ENCODERS)))
     if config.algo == "sb3":
         require_sb3()
+    device = use_device(config.device)  # first: a missing GPU stops the run before any work
     os.makedirs(out_dir, exist_ok=True)
-    device = resolve_device(config.device)
     log("hold_cube_experiment: device %s, %d torch threads, %s" % (
         device, torch.get_num_threads(), json.dumps(_clean(asdict(config)))))
 
