@@ -1,6 +1,7 @@
 """scripts/hold_cube_experiment (norm2tex.rl.hold_cube_experiment): the quick run end to end
 with every output, its numbers in range, the same numbers for the same seed; the environments it
-needs: a batch with one material per environment, and the empty gripper; its device rule."""
+needs: a batch with one material per environment, and the empty gripper; its encoders (resnet18:
+torchvision's, group norm) and its device rule."""
 
 import csv
 import json
@@ -178,17 +179,41 @@ def test_the_same_seed_gives_the_same_json(tmp_path):
     assert a["policies"]["norm2tex"]["evaluation"]["wood"]["episodes"] == 2
 
 
-def test_the_encoders_take_both_images_and_the_opening():
+@pytest.mark.parametrize("encoder", hce.ENCODERS)
+def test_the_encoders_take_both_images_and_the_opening(encoder):
+    if encoder == "resnet18":
+        pytest.importorskip("torchvision",
+                            reason="torchvision is not installed (Debian: python3-torchvision)")
     obs = {"opening": torch.full((5, 1), 0.6),
            "digit_left": torch.randn(5, 80, 60, 3) * 0.1,
            "digit_right": torch.randn(5, 80, 60, 3) * 0.1}
-    for encoder in hce.ENCODERS:
-        policy = hce.make_policy("norm2tex", (80, 60, 3), encoder)
-        action, logprob, entropy, value = policy.get_action_and_value(obs)
-        assert action.shape == (5,) and value.shape == (5,)
-        # The right image changes the features (shared network, both images used).
-        changed = dict(obs, digit_right=obs["digit_right"] + 0.5)
-        assert not torch.allclose(policy.encoder(obs), policy.encoder(changed))
+    policy = hce.make_policy("norm2tex", (80, 60, 3), encoder)
+    action, logprob, entropy, value = policy.get_action_and_value(obs)
+    assert action.shape == (5,) and value.shape == (5,)
+    # The right image changes the features (shared network, both images used).
+    changed = dict(obs, digit_right=obs["digit_right"] + 0.5)
+    assert not torch.allclose(policy.encoder(obs), policy.encoder(changed))
+
+
+def test_resnet18_encoder_is_torchvisions_with_group_norm():
+    torchvision = pytest.importorskip(
+        "torchvision", reason="torchvision is not installed (Debian: python3-torchvision)")
+    net = hce.ResNet18((80, 60, 3))
+    assert type(net.net) is torchvision.models.ResNet
+    norms = [m for m in net.modules() if isinstance(m, (torch.nn.BatchNorm2d, torch.nn.GroupNorm))]
+    # Stem, 8 blocks x 2, 3 projections: all group norm (PPO acts on one state at a time).
+    assert len(norms) == 20 and all(isinstance(m, torch.nn.GroupNorm) for m in norms)
+    assert net(torch.zeros(3, 3, 80, 60)).shape == (3, hce.FEATURES)
+    # The same network is the same at batch 1 and inside a batch (batch norm would not be).
+    net.train()
+    x = torch.randn(4, 3, 80, 60)
+    assert torch.allclose(net(x[:1]), net(x)[:1], atol=1e-5)
+
+
+def test_the_blind_encoder_ignores_the_images():
+    obs = {"opening": torch.full((5, 1), 0.6),
+           "digit_left": torch.randn(5, 80, 60, 3) * 0.1,
+           "digit_right": torch.randn(5, 80, 60, 3) * 0.1}
     blind = hce.make_policy("blind", None)
     changed = dict(obs, digit_left=obs["digit_left"] + 0.5)
     assert torch.equal(blind.encoder(obs), blind.encoder(changed))

@@ -14,9 +14,9 @@ episodes of the held-out variants 20-23 and held-out seeds. The physical drop th
 material (norm2tex.envs.drop_threshold) is measured alongside.
 
 The images are background-subtracted (image="diff_float") and averaged down `downscale` x
-`downscale` (4: 80 x 60 pixels); one CNN ("cnn": three strided convolutions, or "resnet18") is
-applied to both, and its two feature vectors are concatenated with the opening. The opening
-enters every policy as (opening - 0.6) / 0.05.
+`downscale` (4: 80 x 60 pixels); one CNN ("cnn": three strided convolutions, or "resnet18":
+torchvision's, randomly initialised, group norm) is applied to both, and its two feature vectors
+are concatenated with the opening. The opening enters every policy as (opening - 0.6) / 0.05.
 
 Budget (the default ExperimentConfig): 150 000 environment steps per policy (6 environments x
 128 steps per update, 195 updates). On the project's 2-core VM: blind 312 steps/s, textureless
@@ -55,6 +55,7 @@ from torch import nn
 
 from norm2tex.envs import HoldCubeVectorEnv, drop_threshold
 from norm2tex.envs.hold_cube import HORIZON
+from norm2tex.resnet import resnet18
 from norm2tex.rl import ppo
 from norm2tex.torch_device import resolve_device
 
@@ -82,7 +83,7 @@ class ExperimentConfig:
     entropy_coef: float = 0.01
     horizon: int = HORIZON             # steps per episode (the paper: 128)
     downscale: int = 4
-    encoder: str = "cnn"               # "cnn" or "resnet18" (no pretrained weights)
+    encoder: str = "cnn"               # "cnn" or "resnet18" (torchvision's, random weights)
     algo: str = "ppo"                  # "ppo" (norm2tex.rl.ppo) or "sb3" (stable_baselines3)
     materials: tuple = MATERIALS
     conditions: tuple = CONDITIONS
@@ -158,44 +159,25 @@ class SmallCNN(nn.Module):
         return self.fc(self.conv(x))
 
 
-class _Block(nn.Module):
-    """ResNet's basic block, with group norm (PPO acts with one state at a time and updates on
-    minibatches: batch norm would make the two disagree)."""
-
-    def __init__(self, cin, cout, stride):
-        super().__init__()
-        self.conv1 = nn.Conv2d(cin, cout, 3, stride, 1, bias=False)
-        self.n1 = nn.GroupNorm(8, cout)
-        self.conv2 = nn.Conv2d(cout, cout, 3, 1, 1, bias=False)
-        self.n2 = nn.GroupNorm(8, cout)
-        self.short = None
-        if stride != 1 or cin != cout:
-            self.short = nn.Sequential(nn.Conv2d(cin, cout, 1, stride, bias=False),
-                                       nn.GroupNorm(8, cout))
-
-    def forward(self, x):
-        y = torch.relu(self.n1(self.conv1(x)))
-        y = self.n2(self.conv2(y))
-        return torch.relu(y + (x if self.short is None else self.short(x)))
+def _group_norm(channels):
+    """Group norm for ResNet18's norm layers: PPO acts with one state at a time and updates on
+    minibatches, and batch norm would make the two disagree. (A module-level function, not a
+    lambda, so that the policy pickles.)"""
+    return nn.GroupNorm(8, channels)
 
 
 class ResNet18(nn.Module):
-    """ResNet-18 ([2, 2, 2, 2] basic blocks, 64-512 channels), randomly initialised, group norm
-    instead of batch norm; global average pooling and a linear layer to `out` features."""
+    """torchvision's ResNet-18 ([2, 2, 2, 2] basic blocks, 64-512 channels), randomly
+    initialised, with group norm instead of batch norm; its global average pooling feeds a
+    linear layer and a ReLU to `out` features."""
 
     def __init__(self, image_shape=None, out=FEATURES):
         super().__init__()
-        layers = [nn.Conv2d(3, 64, 7, 2, 3, bias=False), nn.GroupNorm(8, 64), nn.ReLU(),
-                  nn.MaxPool2d(3, 2, 1)]
-        cin = 64
-        for cout, stride in ((64, 1), (128, 2), (256, 2), (512, 2)):
-            layers += [_Block(cin, cout, stride), _Block(cout, cout, 1)]
-            cin = cout
-        self.body = nn.Sequential(*layers, nn.AdaptiveAvgPool2d(1), nn.Flatten())
-        self.fc = nn.Sequential(nn.Linear(512, out), nn.ReLU())
+        self.net = resnet18(norm_layer=_group_norm)
+        self.net.fc = nn.Sequential(nn.Linear(self.net.fc.in_features, out), nn.ReLU())
 
     def forward(self, x):
-        return self.fc(self.body(x))
+        return self.net(x)
 
 
 class TactileEncoder(nn.Module):
