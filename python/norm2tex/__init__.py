@@ -35,7 +35,6 @@ _CORE_NAMES = (
     "material_texture",
     "RenderedFrame",
     "read_image",
-    "block_mean",
     "calibrate_sensor",
     "measure_ridge_contrast",
     "TactileRenderer",
@@ -57,11 +56,18 @@ _CORE_NAMES = (
     "TactileHand",
 )
 
-__all__ = list(_CORE_NAMES) + ["config_dir", "config_path", "material_config", "scene_config"]
+# Python functions exported here, imported on first use like the core's names (name: module).
+_PYTHON_NAMES = {"block_mean": "norm2tex.blocks"}
+
+__all__ = (list(_CORE_NAMES) + list(_PYTHON_NAMES)
+           + ["config_dir", "config_path", "material_config", "scene_config"])
 
 
 def __getattr__(name):
-    """Imports the compiled core when one of its names is first asked for (PEP 562)."""
+    """Imports the compiled core (or a Python module) when one of its names is first asked for
+    (PEP 562)."""
+    if name in _PYTHON_NAMES:
+        return getattr(_importlib.import_module(_PYTHON_NAMES[name]), name)
     if name in _CORE_NAMES or name == "_core":
         try:
             # import_module, not "from norm2tex import _core": that asks this very __getattr__.
@@ -77,4 +83,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(list(globals().keys()) + list(_CORE_NAMES))
+    return sorted(list(globals().keys()) + list(_CORE_NAMES) + list(_PYTHON_NAMES))

@@ -1,6 +1,6 @@
 """Material classification from tactile frames: the models and the held-out-variant experiment
-of ``scripts/train_material_classifier`` (needs PyTorch; imported on its own, not by
-``import norm2tex``).
+of ``scripts/train_material_classifier`` (needs PyTorch, and torchvision for ResNet-18; imported
+on its own, not by ``import norm2tex``).
 
 The input is a background-subtracted frame (``ExportedDataset(image="diff")``: float grey
 levels, 3 x 320 x 240 BGR for a QVGA DIGIT), averaged over ``downscale`` x ``downscale`` pixel
@@ -22,6 +22,10 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
+from norm2tex.blocks import CHANNELS_FIRST, block_mean
+from norm2tex.resnet import resnet18
+from norm2tex.torch_device import resolve_device
+
 ARCHS = ("small", "resnet18")
 DOWNSCALES = (1, 2, 4)
 # The diff frames are grey-level differences of a few tens; this brings them near unit scale.
@@ -29,7 +33,8 @@ INPUT_SCALE = 32.0
 
 
 class Downscale(nn.Module):
-    """Scales the diff frame to ~unit values and averages it over factor x factor blocks."""
+    """Scales the diff frame to ~unit values and averages it over factor x factor blocks
+    (norm2tex.block_mean: rows and columns past the last whole block are dropped)."""
 
     def __init__(self, factor):
         super().__init__()
@@ -38,8 +43,7 @@ class Downscale(nn.Module):
         self.factor = factor
 
     def forward(self, x):
-        x = x / INPUT_SCALE
-        return F.avg_pool2d(x, self.factor) if self.factor > 1 else x
+        return block_mean(x / INPUT_SCALE, self.factor, axes=CHANNELS_FIRST)
 
 
 class SmallTactileNet(nn.Module):
@@ -61,61 +65,30 @@ class SmallTactileNet(nn.Module):
         return self.fc(x.mean(dim=(2, 3)))
 
 
-class BasicBlock(nn.Module):
-    """ResNet's basic block: two 3x3 convolutions with batch norm and an identity (or a 1x1
-    projection when the shape changes) added before the last ReLU (He et al. 2016)."""
-
-    expansion = 1
-
-    def __init__(self, inplanes, planes, stride=1):
-        super().__init__()
-        self.conv1 = nn.Conv2d(inplanes, planes, 3, stride=stride, padding=1, bias=False)
-        self.bn1 = nn.BatchNorm2d(planes)
-        self.conv2 = nn.Conv2d(planes, planes, 3, padding=1, bias=False)
-        self.bn2 = nn.BatchNorm2d(planes)
-        self.shortcut = None
-        if stride != 1 or inplanes != planes:
-            self.shortcut = nn.Sequential(
-                nn.Conv2d(inplanes, planes, 1, stride=stride, bias=False), nn.BatchNorm2d(planes))
-
-    def forward(self, x):
-        out = F.relu(self.bn1(self.conv1(x)))
-        out = self.bn2(self.conv2(out))
-        identity = x if self.shortcut is None else self.shortcut(x)
-        return F.relu(out + identity)
-
-
 class ResNet18(nn.Module):
-    """ResNet-18 (BasicBlock, [2, 2, 2, 2], 64-512 channels) as torchvision builds it, randomly
-    initialised (no pretrained weights), after the same input averaging as the small net.
-    The paper's classifier architecture; ~11 M parameters, meant for a GPU."""
+    """torchvision's ResNet-18 (BasicBlock, [2, 2, 2, 2], 64-512 channels), randomly initialised
+    (no pretrained weights), after the same input averaging as the small net; its stem takes
+    `channels` input channels and its last layer gives `classes` logits. The paper's classifier
+    architecture; ~11 M parameters, meant for a GPU."""
 
-    def __init__(self, classes, downscale=4, channels=3, layers=(2, 2, 2, 2)):
+    def __init__(self, classes, downscale=4, channels=3):
         super().__init__()
         self.downscale = Downscale(downscale)
-        self.conv1 = nn.Conv2d(channels, 64, 7, stride=2, padding=3, bias=False)
-        self.bn1 = nn.BatchNorm2d(64)
-        stages, inplanes = [], 64
-        for i, (planes, blocks) in enumerate(zip((64, 128, 256, 512), layers)):
-            stride = 1 if i == 0 else 2
-            stage = [BasicBlock(inplanes, planes, stride)]
-            stage += [BasicBlock(planes, planes) for _ in range(blocks - 1)]
-            stages.append(nn.Sequential(*stage))
-            inplanes = planes
-        self.layer1, self.layer2, self.layer3, self.layer4 = stages
-        self.fc = nn.Linear(512 * BasicBlock.expansion, classes)
-        for m in self.modules():
-            if isinstance(m, nn.Conv2d):
-                nn.init.kaiming_normal_(m.weight, mode="fan_out", nonlinearity="relu")
-            elif isinstance(m, nn.BatchNorm2d):
-                nn.init.ones_(m.weight)
-                nn.init.zeros_(m.bias)
+        self.net = resnet18(num_classes=classes)
+        if channels != self.net.conv1.in_channels:
+            self.net.conv1 = _stem(channels, self.net.conv1)
 
     def forward(self, x):
-        x = self.downscale(x)
-        x = F.max_pool2d(F.relu(self.bn1(self.conv1(x))), 3, stride=2, padding=1)
-        x = self.layer4(self.layer3(self.layer2(self.layer1(x))))
-        return self.fc(x.mean(dim=(2, 3)))
+        return self.net(self.downscale(x))
+
+
+def _stem(channels, conv):
+    """`conv` (torchvision's 7x7 stride-2 stem) for `channels` input channels, initialised as
+    torchvision initialises its convolutions."""
+    stem = nn.Conv2d(channels, conv.out_channels, conv.kernel_size, stride=conv.stride,
+                     padding=conv.padding, bias=False)
+    nn.init.kaiming_normal_(stem.weight, mode="fan_out", nonlinearity="relu")
+    return stem
 
 
 def use_deterministic_kernels():
@@ -135,18 +108,6 @@ def build_model(arch, classes, downscale=4, channels=3):
     if arch == "resnet18":
         return ResNet18(classes, downscale, channels)
     raise ValueError(f"unknown arch {arch!r}: choose one of {', '.join(ARCHS)}")
-
-
-def resolve_device(device):
-    """"auto" -> "cuda" when PyTorch sees a GPU, else "cpu"; "cuda" without one is an error."""
-    if device == "auto":
-        return "cuda" if torch.cuda.is_available() else "cpu"
-    if device == "cuda" and not torch.cuda.is_available():
-        raise RuntimeError("--device cuda, but PyTorch sees no CUDA GPU (torch.cuda.is_available()"
-                           " is False); use --device cpu or auto")
-    if device not in ("cpu", "cuda"):
-        raise ValueError(f"device must be auto, cpu or cuda, not {device!r}")
-    return device
 
 
 def split(export_dir, test_variants):
@@ -200,12 +161,13 @@ def run(export_dir, test_variants=(3,), epochs=12, seed=0, downscale=4, arch="sm
         raise ValueError(f"unknown arch {arch!r}: choose one of {', '.join(ARCHS)}")
     if downscale not in DOWNSCALES:
         raise ValueError(f"downscale must be one of {DOWNSCALES}, not {downscale!r}")
-    device = resolve_device(device)
+    device = resolve_device(device)  # "auto": cuda when PyTorch sees a GPU, else cpu
     if threads:
         torch.set_num_threads(threads)
     torch.manual_seed(seed)
     use_deterministic_kernels()
-    if device == "cuda":
+    on_gpu = device.startswith("cuda")
+    if on_gpu:
         torch.backends.cudnn.benchmark = False
     train, test, classes = split(export_dir, test_variants)
     train_variants = sorted({r["variant"] for r in train.rows})
@@ -213,12 +175,11 @@ def run(export_dir, test_variants=(3,), epochs=12, seed=0, downscale=4, arch="sm
     log(f"{len(train)} training frames (variants {train_variants}), {len(test)} held-out "
         f"(variants {held_out}); classes {classes}; {arch}, {downscale}x averaging, {device}")
     order = torch.Generator().manual_seed(seed)
-    pin = device == "cuda"
     train_loader = torch.utils.data.DataLoader(train, batch_size=batch_size, shuffle=True,
                                                generator=order, num_workers=workers,
-                                               pin_memory=pin)
+                                               pin_memory=on_gpu)
     test_loader = torch.utils.data.DataLoader(test, batch_size=64, num_workers=workers,
-                                              pin_memory=pin)
+                                              pin_memory=on_gpu)
     model = build_model(arch, len(classes), downscale).to(device)
     optimiser = torch.optim.Adam(model.parameters(), lr=lr)
     history = []

@@ -117,11 +117,15 @@ class PackageDependencies(unittest.TestCase):
             resolve("python3-torch", "ubuntu", "focal", self.rules, self.ros_packages)
         self.assertEqual(resolve("python3-torch", "ubuntu", "jammy", self.rules, self.ros_packages),
                          ["python3-torch"])
+        # torchvision likewise: null on focal, so package.xml cannot declare it either.
+        with self.assertRaisesRegex(UnresolvableKey, "not available for ubuntu focal"):
+            resolve("python3-torchvision", "ubuntu", "focal", self.rules, self.ros_packages)
         with self.assertRaisesRegex(UnresolvableKey, "in no rule"):
             resolve("no-such-key", "ubuntu", "focal", self.rules, self.ros_packages)
         self.assertEqual(resolve("tf2_ros", "ubuntu", "focal", self.rules, self.ros_packages),
                          ["ros-noetic-tf2-ros"])
         self.assertNotIn("python3-torch", self.deps)
+        self.assertNotIn("python3-torchvision", self.deps)
 
     def test_every_ros_package_the_code_uses_is_declared(self):
         used = set()
@@ -156,8 +160,10 @@ class PackageDependencies(unittest.TestCase):
             wanted = resolve(key, "debian", "bookworm", self.rules, self.ros_packages)
             missing += ["%s (%s)" % (p, key) for p in wanted if p not in listed]
         self.assertEqual(missing, [], "scripts/debian-packages.txt lacks what package.xml needs")
-        # PyTorch is not a rosdep key (null on focal) but the Python tools need it: Debian's is listed.
+        # PyTorch and torchvision are not declared (null on focal) but the Python tools need them:
+        # Debian's are listed.
         self.assertIn("python3-torch", listed)
+        self.assertIn("python3-torchvision", listed)
 
     @unittest.skipIf(shutil.which("catkin_lint") is None, "catkin_lint is not installed (catkin-lint)")
     def test_catkin_lint_finds_no_error(self):

@@ -242,7 +242,7 @@ def test_conformity_from_python_follows_the_force(sensor, cube):
 
 
 def numpy_block_mean(images, factor, background=None):
-    """The reshape-mean the environments used before norm2tex.block_mean (the reference)."""
+    """The reshape-mean the environments used before the core's block_mean (the reference)."""
     x = images if background is None else (
         images.astype(np.int16) - background.astype(np.int16)[None])
     n, rows, cols = x.shape[:3]
@@ -251,27 +251,30 @@ def numpy_block_mean(images, factor, background=None):
     return blocks.mean(axis=(2, 4), dtype=np.float32)
 
 
-def test_block_mean_equals_numpy_bit_for_bit_and_refuses_bad_input():
+def test_core_block_mean_equals_numpy_bit_for_bit_and_refuses_bad_input():
+    # The binding itself; norm2tex.block_mean (any array) sends bgr8 frames to it
+    # (test_block_mean.py).
+    core_block_mean = norm2tex._core.block_mean
     rng = np.random.default_rng(3)
     images = rng.integers(0, 256, size=(3, 61, 47, 3), dtype=np.uint8)
     background = rng.integers(0, 256, size=(61, 47, 3), dtype=np.uint8)
     for factor in (1, 2, 3, 4, 5):
         for bg in (None, background):
             expected = numpy_block_mean(images, factor, bg)
-            got = norm2tex.block_mean(images, factor, bg)
+            got = core_block_mean(images, factor, bg)
             assert got.dtype == np.float32 and got.shape == expected.shape
             assert np.array_equal(got, expected), (factor, bg is None)
             # One image: the batch's first, without the batch axis.
-            assert np.array_equal(norm2tex.block_mean(images[0], factor, bg), expected[0])
+            assert np.array_equal(core_block_mean(images[0], factor, bg), expected[0])
     # A non-contiguous batch (every other image) is read correctly too.
-    assert np.array_equal(norm2tex.block_mean(images[::2], 4), numpy_block_mean(images[::2], 4))
+    assert np.array_equal(core_block_mean(images[::2], 4), numpy_block_mean(images[::2], 4))
     for bad in (dict(images=images.astype(np.int16), factor=2),
                 dict(images=images[..., :2], factor=2),
                 dict(images=images, factor=0),
                 dict(images=images, factor=48),
                 dict(images=images, factor=2, background=background[:60])):
         with pytest.raises(ValueError):
-            norm2tex.block_mean(**bad)
+            core_block_mean(**bad)
 
 
 def test_command_modes_are_one_set_of_values():

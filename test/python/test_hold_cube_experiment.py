@@ -1,6 +1,8 @@
 """scripts/hold_cube_experiment (norm2tex.rl.hold_cube_experiment): the quick run end to end
 with every output, its numbers in range, the same numbers for the same seed; the environments it
-needs: a batch with one material per environment, and the empty gripper."""
+needs: a batch with one material per environment, and the empty gripper; its figures
+(norm2tex.rl.figures: what each shows, PNGs of their sizes), its encoders (resnet18:
+torchvision's, group norm) and its device rule."""
 
 import csv
 import json
@@ -16,7 +18,9 @@ torch = pytest.importorskip("torch", reason="PyTorch is not installed (Debian: p
 
 import norm2tex  # noqa: E402
 from norm2tex.envs import HoldCubeEnv, HoldCubeVectorEnv, hold_reward  # noqa: E402
+from norm2tex.rl import figures  # noqa: E402
 from norm2tex.rl import hold_cube_experiment as hce  # noqa: E402
+from norm2tex.torch_device import DeviceUnavailable, resolve_device  # noqa: E402
 
 MATERIALS = ["wood", "fabric", "smooth"]
 
@@ -146,9 +150,19 @@ def _check_outputs(out, results, config):
         assert spread["ci95"][0] <= spread["range"] <= spread["ci95"][1]
     table = hce.results_table(results)
     assert table.count("\n") == len(config.materials) + 2 + (1 if config.eval_empty else 0)
+    assert_png(os.path.join(out, "opening_vs_step.png"),
+               figures.openings_size_px(len(config.conditions)))
+    assert_png(os.path.join(out, "training_curves.png"), figures.TRAINING_SIZE_PX)
+
+
+def assert_png(path, size):
     from PIL import Image
 
-    assert Image.open(os.path.join(out, "opening_vs_step.png")).size[0] > 600
+    with open(path, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n", path
+    with Image.open(path) as image:
+        image.load()  # decodes every row: a truncated file fails here
+        assert image.format == "PNG" and image.size == tuple(size), (path, image.size)
 
 
 def test_quick_run_writes_every_output(tmp_path):
@@ -177,17 +191,41 @@ def test_the_same_seed_gives_the_same_json(tmp_path):
     assert a["policies"]["norm2tex"]["evaluation"]["wood"]["episodes"] == 2
 
 
-def test_the_encoders_take_both_images_and_the_opening():
+@pytest.mark.parametrize("encoder", hce.ENCODERS)
+def test_the_encoders_take_both_images_and_the_opening(encoder):
+    if encoder == "resnet18":
+        pytest.importorskip("torchvision",
+                            reason="torchvision is not installed (Debian: python3-torchvision)")
     obs = {"opening": torch.full((5, 1), 0.6),
            "digit_left": torch.randn(5, 80, 60, 3) * 0.1,
            "digit_right": torch.randn(5, 80, 60, 3) * 0.1}
-    for encoder in hce.ENCODERS:
-        policy = hce.make_policy("norm2tex", (80, 60, 3), encoder)
-        action, logprob, entropy, value = policy.get_action_and_value(obs)
-        assert action.shape == (5,) and value.shape == (5,)
-        # The right image changes the features (shared network, both images used).
-        changed = dict(obs, digit_right=obs["digit_right"] + 0.5)
-        assert not torch.allclose(policy.encoder(obs), policy.encoder(changed))
+    policy = hce.make_policy("norm2tex", (80, 60, 3), encoder)
+    action, logprob, entropy, value = policy.get_action_and_value(obs)
+    assert action.shape == (5,) and value.shape == (5,)
+    # The right image changes the features (shared network, both images used).
+    changed = dict(obs, digit_right=obs["digit_right"] + 0.5)
+    assert not torch.allclose(policy.encoder(obs), policy.encoder(changed))
+
+
+def test_resnet18_encoder_is_torchvisions_with_group_norm():
+    torchvision = pytest.importorskip(
+        "torchvision", reason="torchvision is not installed (Debian: python3-torchvision)")
+    net = hce.ResNet18((80, 60, 3))
+    assert type(net.net) is torchvision.models.ResNet
+    norms = [m for m in net.modules() if isinstance(m, (torch.nn.BatchNorm2d, torch.nn.GroupNorm))]
+    # Stem, 8 blocks x 2, 3 projections: all group norm (PPO acts on one state at a time).
+    assert len(norms) == 20 and all(isinstance(m, torch.nn.GroupNorm) for m in norms)
+    assert net(torch.zeros(3, 3, 80, 60)).shape == (3, hce.FEATURES)
+    # The same network is the same at batch 1 and inside a batch (batch norm would not be).
+    net.train()
+    x = torch.randn(4, 3, 80, 60)
+    assert torch.allclose(net(x[:1]), net(x)[:1], atol=1e-5)
+
+
+def test_the_blind_encoder_ignores_the_images():
+    obs = {"opening": torch.full((5, 1), 0.6),
+           "digit_left": torch.randn(5, 80, 60, 3) * 0.1,
+           "digit_right": torch.randn(5, 80, 60, 3) * 0.1}
     blind = hce.make_policy("blind", None)
     changed = dict(obs, digit_left=obs["digit_left"] + 0.5)
     assert torch.equal(blind.encoder(obs), blind.encoder(changed))
@@ -203,3 +241,66 @@ def test_sb3_is_refused_clearly_when_missing(tmp_path):
         pass
     with pytest.raises(RuntimeError, match="stable_baselines3"):
         hce.run(replace(hce.quick_config(), algo="sb3"), str(tmp_path), log=lambda line: None)
+
+
+def synthetic_results(horizon=8):
+    """A results dict as run() returns it, with known numbers (no training)."""
+    steps = horizon + 1
+    evaluation = {m: {"opening_mean": [0.5 + 0.01 * k] * steps, "opening_std": [0.02] * steps,
+                      "drop_rate": 0.25 * k}
+                  for k, m in enumerate(["wood", "fabric", "smooth", "empty"])}
+    training = [{"steps": 48 * (u + 1), "mean_return": 4.0 + u} for u in range(3)]
+    return {"thresholds": {"wood": 0.5725, "fabric": 0.585, "smooth": 0.5475},
+            "policies": {p: {"evaluation": evaluation, "training": training}
+                         for p in ("blind", "textureless", "norm2tex")}}
+
+
+def test_the_opening_figure_shows_the_data():
+    config = replace(hce.quick_config(), horizon=8, eval_episodes=7)
+    fig = figures.openings_figure(synthetic_results(), config)
+    axes = fig.axes
+    assert [ax.get_title() for ax in axes] == ["blind", "textureless", "norm2tex"]
+    assert axes[0].get_ylabel() == "opening" and all(ax.get_xlabel() == "step" for ax in axes)
+    for ax in axes:
+        assert ax.get_xlim() == (0, 8)
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+            "wood  drop 0%", "fabric  drop 25%", "smooth  drop 50%", "empty  drop 75%"]
+        curves = [line for line in ax.get_lines() if line.get_linestyle() == "-"]
+        assert [list(line.get_ydata()) for line in curves][1] == [0.51] * 9
+        # The +- std band of every material: from mean - std to mean + std.
+        assert len(ax.collections) == 4
+        band = ax.collections[1].get_paths()[0].vertices[:, 1]
+        assert min(band) == pytest.approx(0.49) and max(band) == pytest.approx(0.53)
+        dashed = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+        assert sorted(line.get_ydata()[0] for line in dashed) == [0.5475, 0.5725, 0.585]
+    assert any("over 7 held-out episodes" in t.get_text() for t in fig.texts)
+
+
+def test_the_training_figure_shows_the_data():
+    config = replace(hce.quick_config(), total_steps=144)
+    ax = figures.training_figure(synthetic_results(), config).axes[0]
+    assert ax.get_title() == "PPO training: mean episode return"
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("environment steps", "return")
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "blind", "textureless", "norm2tex"]
+    assert list(ax.get_lines()[0].get_xdata()) == [48, 96, 144]
+    assert list(ax.get_lines()[0].get_ydata()) == [4.0, 5.0, 6.0]
+
+
+def test_the_figures_are_pngs_of_their_size(tmp_path):
+    results, config = synthetic_results(), replace(hce.quick_config(), horizon=8)
+    figures.plot_openings(str(tmp_path / "o.png"), results, config)
+    figures.plot_training(str(tmp_path / "t.png"), results, config)
+    assert figures.openings_size_px(3) == (1420, 480)
+    assert_png(str(tmp_path / "o.png"), (1420, 480))
+    assert_png(str(tmp_path / "t.png"), figures.TRAINING_SIZE_PX)
+
+
+def test_a_device_that_is_not_there_stops_the_run_before_it_starts(tmp_path):
+    assert hce.resolve_device is resolve_device  # the package's one rule
+    if torch.cuda.is_available():
+        pytest.skip("PyTorch sees a GPU here")
+    with pytest.raises(DeviceUnavailable, match="'cuda' was asked for"):
+        hce.run(replace(hce.quick_config(), device="cuda"), str(tmp_path / "out"),
+                log=lambda line: None)
+    assert not (tmp_path / "out").exists()

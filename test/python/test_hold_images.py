@@ -29,13 +29,6 @@ def test_a_scripted_hold_reaches_its_opening_and_images_show_the_press():
     assert (np.abs(left - flat).max(axis=-1)[~contact] * 255).mean() < texture.mean() / 3
 
 
-def test_shrink_averages_blocks():
-    images = np.arange(2 * 8 * 4 * 3, dtype=np.float32).reshape(2, 8, 4, 3)
-    small = hold_images._shrink(images, 4)
-    assert small.shape == (2, 2, 1, 3)
-    np.testing.assert_allclose(small[1, 1, 0], images[1, 4:8, 0:4].mean(axis=(0, 1)))
-
-
 def test_texture_separates_wood_from_smooth_and_textureless_does_not():
     study = hold_images.separability_study(
         materials=("wood", "smooth"), downscales=(4,), train_episodes=32, test_episodes=8,

@@ -1,8 +1,9 @@
 """norm2tex.classify and scripts/train_material_classifier on a synthetic export: two classes
 that differ only by stripes of a 2-pixel period. At full resolution the classifier learns
 them; averaged 2x or 4x it cannot (the average of a 2-px period over 2 or 4 pixels is exactly
-zero), which is what --downscale decides about real textures. Also ResNet-18's shape, size
-and one training step, the JSON's keys, the same seed's same result, and the errors."""
+zero), which is what --downscale decides about real textures. Also ResNet-18 (torchvision's:
+its type, shape, size, one training step, and the stripes learnt), the JSON's keys, the same
+seed's same result, and the errors (an unavailable --device among them)."""
 
 import csv
 import json
@@ -103,10 +104,21 @@ def test_same_seed_same_result(export):
     assert other["history"] != first["history"]
 
 
-def test_resnet18_shape_size_and_one_step():
+def need_torchvision():
+    return pytest.importorskip("torchvision",
+                               reason="torchvision is not installed (Debian: python3-torchvision)")
+
+
+def test_resnet18_is_torchvisions_shape_size_and_one_step():
+    torchvision = need_torchvision()
     torch.manual_seed(0)
     model = classify.build_model("resnet18", 5, downscale=4)
+    assert type(model.net) is torchvision.models.ResNet
     assert model(torch.zeros(2, 3, 320, 240)).shape == (2, 5)
+    # Another number of input channels: torchvision's stem, rebuilt for them.
+    grey = classify.build_model("resnet18", 5, downscale=2, channels=1)
+    assert grey.net.conv1.in_channels == 1 and grey.net.conv1.kernel_size == (7, 7)
+    assert grey(torch.zeros(2, 1, 320, 240)).shape == (2, 5)
     # torchvision's resnet18 for 1000 classes has 11 689 512 parameters.
     assert sum(p.numel() for p in classify.ResNet18(1000).parameters()) == 11689512
     images, targets = torch.randn(8, 3, 64, 48) * 20, torch.arange(8) % 5
@@ -119,6 +131,14 @@ def test_resnet18_shape_size_and_one_step():
     optimiser.step()
     after = torch.nn.functional.cross_entropy(model(images), targets)
     assert after.item() < before.item()
+
+
+def test_resnet18_sees_two_pixel_stripes(export):
+    need_torchvision()
+    result = train(export, downscale=1, arch="resnet18", epochs=2)  # 100 % here, ~10 s
+    assert result["settings"]["arch"] == "resnet18"
+    assert result["settings"]["parameters"] == 11177538  # torchvision's, for two classes
+    assert result["overall"]["accuracy"] >= 0.9, result["confusion"]
 
 
 def test_small_net_output_shape():
@@ -163,11 +183,20 @@ def test_json_has_every_number(export, tmp_path):
     (["--test-variants", "7"], "no frames of the held-out variants [7]"),
     (["--test-variants", "0,1,2"], "no variant left to train on"),
     (["--arch", "vgg"], "unknown --arch 'vgg'"),
+    (["--device", "gpu"], "device 'gpu' is not a device name: auto, cpu, cuda or cuda:N"),
 ])
 def test_clear_errors(export, args, message):
     ran = run_script(export, "--epochs", "1", "--workers", "0", *args)
     assert ran.returncode != 0
     assert message in ran.stderr, ran.stderr
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="PyTorch sees a GPU here")
+def test_a_device_that_is_not_there_is_an_error_not_a_cpu_run(export):
+    ran = run_script(export, "--epochs", "1", "--workers", "0", "--device", "cuda")
+    assert ran.returncode != 0 and "held-out confusion" not in ran.stdout
+    assert "'cuda' was asked for, but PyTorch sees no CUDA GPU" in ran.stderr, ran.stderr
+    assert "available: cpu" in ran.stderr, ran.stderr
 
 
 def test_errors_of_the_module(export):

@@ -14,6 +14,7 @@ import os
 import numpy as np
 
 import norm2tex
+from norm2tex.blocks import block_mean
 from norm2tex.envs import spaces
 from norm2tex.envs.commands import (ABSOLUTE, CLOSE, DELTA, DISCRETE_DELTA, KEEP, OPEN,  # noqa
                                     STAY)
@@ -243,28 +244,18 @@ class GripperVectorEnv(spaces.EnvBase):
         return spaces.Box(0.0, 1.0, shape=(1,), dtype=np.float32)
 
     # --- observations -----------------------------------------------------------------------
-    def _shrink(self, images):
-        f = self.downscale
-        if f == 1:
-            return images
-        n, rows, cols = images.shape[:3]
-        r, c = rows // f * f, cols // f * f
-        tail = images.shape[3:]
-        blocks = images[:, :r, :c].reshape((n, r // f, f, c // f, f) + tail)
-        return blocks.mean(axis=(2, 4), dtype=np.float32)
-
     def _image_obs(self, finger):
         images = self.backend.images(finger)
         if self.image_mode == "raw":
             if self.downscale == 1:
                 return images
-            return np.rint(norm2tex.block_mean(images, self.downscale)).astype(np.uint8)
+            return np.rint(block_mean(images, self.downscale)).astype(np.uint8)
         if self.downscale == 1:
             out = images.astype(np.int16) - self._backgrounds[finger].astype(np.int16)[None]
         else:
             # The core's block mean: numpy's reshape-mean, bit for bit, at a twentieth of the
             # cost (it was most of a training step's time).
-            out = norm2tex.block_mean(images, self.downscale, self._backgrounds[finger])
+            out = block_mean(images, self.downscale, self._backgrounds[finger])
         if self.image_mode == "diff_int16":
             return np.rint(out).astype(np.int16) if out.dtype != np.int16 else out
         return (out / 255.0).astype(np.float32)
@@ -277,8 +268,9 @@ class GripperVectorEnv(spaces.EnvBase):
         }
         if self.with_depth:
             for f in FINGERS:
+                depths = self.backend.depths(f)  # (N, rows, cols): no channel axis
                 obs["depth_" + f] = np.clip(
-                    self._shrink(self.backend.depths(f)[..., None])[..., 0], 0.0, 0.01
+                    block_mean(depths, self.downscale, axes=(-2, -1)), 0.0, 0.01
                 ).astype(np.float32)
         if self.with_force:
             obs["force"] = state["normal_force_n"].astype(np.float32)

@@ -14,9 +14,9 @@ episodes of the held-out variants 20-23 and held-out seeds. The physical drop th
 material (norm2tex.envs.drop_threshold) is measured alongside.
 
 The images are background-subtracted (image="diff_float") and averaged down `downscale` x
-`downscale` (4: 80 x 60 pixels); one CNN ("cnn": three strided convolutions, or "resnet18") is
-applied to both, and its two feature vectors are concatenated with the opening. The opening
-enters every policy as (opening - 0.6) / 0.05.
+`downscale` (4: 80 x 60 pixels); one CNN ("cnn": three strided convolutions, or "resnet18":
+torchvision's, randomly initialised, group norm) is applied to both, and its two feature vectors
+are concatenated with the opening. The opening enters every policy as (opening - 0.6) / 0.05.
 
 Budget (the default ExperimentConfig): 150 000 environment steps per policy (6 environments x
 128 steps per update, 195 updates). On the project's 2-core VM: blind 312 steps/s, textureless
@@ -37,6 +37,7 @@ Outputs of run(config, out_dir) (also returned as a dict):
                           material (mean +- std over episodes), each threshold a dashed line
   training_curves.png     mean training return vs environment steps, one curve per policy
   policy_<policy>.pt      the trained weights (state_dict)
+The figures are drawn with matplotlib (norm2tex.rl.figures).
 
 Deterministic: the same config gives the same results.json on the same machine (torch's CPU
 kernels with a fixed thread count; timings are only in the training CSVs).
@@ -55,7 +56,9 @@ from torch import nn
 
 from norm2tex.envs import HoldCubeVectorEnv, drop_threshold
 from norm2tex.envs.hold_cube import HORIZON
-from norm2tex.rl import ppo
+from norm2tex.resnet import resnet18
+from norm2tex.rl import figures, ppo
+from norm2tex.torch_device import resolve_device
 
 CONDITIONS = ("blind", "textureless", "norm2tex")
 MATERIALS = ("wood", "fabric", "smooth")
@@ -81,7 +84,7 @@ class ExperimentConfig:
     entropy_coef: float = 0.01
     horizon: int = HORIZON             # steps per episode (the paper: 128)
     downscale: int = 4
-    encoder: str = "cnn"               # "cnn" or "resnet18" (no pretrained weights)
+    encoder: str = "cnn"               # "cnn" or "resnet18" (torchvision's, random weights)
     algo: str = "ppo"                  # "ppo" (norm2tex.rl.ppo) or "sb3" (stable_baselines3)
     materials: tuple = MATERIALS
     conditions: tuple = CONDITIONS
@@ -95,7 +98,7 @@ class ExperimentConfig:
     # drop_threshold's openings (None: its default, 0.45-0.70 in steps of 0.0025).
     threshold_openings: tuple = None
     threads: int = 0                   # the simulator's C++ threads (0: every core)
-    device: str = None                 # None: cuda if available, else cpu
+    device: str = None                 # None or "auto": cuda if available, else cpu
     extra: dict = field(default_factory=dict)
 
 
@@ -110,10 +113,10 @@ def quick_config(**overrides):
     return replace(config, **overrides)
 
 
-def resolve_device(device=None):
-    """cuda when available (or asked), else cpu with torch using every core."""
-    if device is None:
-        device = "cuda" if torch.cuda.is_available() else "cpu"
+def use_device(device=None):
+    """resolve_device(device) (an unavailable device is an error); on the CPU torch then uses
+    every core: the simulator and the networks take turns, so each may have them all."""
+    device = resolve_device(device)
     if device == "cpu":
         torch.set_num_threads(os.cpu_count() or 1)
     return device
@@ -157,44 +160,25 @@ class SmallCNN(nn.Module):
         return self.fc(self.conv(x))
 
 
-class _Block(nn.Module):
-    """ResNet's basic block, with group norm (PPO acts with one state at a time and updates on
-    minibatches: batch norm would make the two disagree)."""
-
-    def __init__(self, cin, cout, stride):
-        super().__init__()
-        self.conv1 = nn.Conv2d(cin, cout, 3, stride, 1, bias=False)
-        self.n1 = nn.GroupNorm(8, cout)
-        self.conv2 = nn.Conv2d(cout, cout, 3, 1, 1, bias=False)
-        self.n2 = nn.GroupNorm(8, cout)
-        self.short = None
-        if stride != 1 or cin != cout:
-            self.short = nn.Sequential(nn.Conv2d(cin, cout, 1, stride, bias=False),
-                                       nn.GroupNorm(8, cout))
-
-    def forward(self, x):
-        y = torch.relu(self.n1(self.conv1(x)))
-        y = self.n2(self.conv2(y))
-        return torch.relu(y + (x if self.short is None else self.short(x)))
+def _group_norm(channels):
+    """Group norm for ResNet18's norm layers: PPO acts with one state at a time and updates on
+    minibatches, and batch norm would make the two disagree. (A module-level function, not a
+    lambda, so that the policy pickles.)"""
+    return nn.GroupNorm(8, channels)
 
 
 class ResNet18(nn.Module):
-    """ResNet-18 ([2, 2, 2, 2] basic blocks, 64-512 channels), randomly initialised, group norm
-    instead of batch norm; global average pooling and a linear layer to `out` features."""
+    """torchvision's ResNet-18 ([2, 2, 2, 2] basic blocks, 64-512 channels), randomly
+    initialised, with group norm instead of batch norm; its global average pooling feeds a
+    linear layer and a ReLU to `out` features."""
 
     def __init__(self, image_shape=None, out=FEATURES):
         super().__init__()
-        layers = [nn.Conv2d(3, 64, 7, 2, 3, bias=False), nn.GroupNorm(8, 64), nn.ReLU(),
-                  nn.MaxPool2d(3, 2, 1)]
-        cin = 64
-        for cout, stride in ((64, 1), (128, 2), (256, 2), (512, 2)):
-            layers += [_Block(cin, cout, stride), _Block(cout, cout, 1)]
-            cin = cout
-        self.body = nn.Sequential(*layers, nn.AdaptiveAvgPool2d(1), nn.Flatten())
-        self.fc = nn.Sequential(nn.Linear(512, out), nn.ReLU())
+        self.net = resnet18(norm_layer=_group_norm)
+        self.net.fc = nn.Sequential(nn.Linear(self.net.fc.in_features, out), nn.ReLU())
 
     def forward(self, x):
-        return self.fc(self.body(x))
+        return self.net(x)
 
 
 class TactileEncoder(nn.Module):
@@ -252,7 +236,7 @@ def _ppo_config(config):
 def train_condition(condition, config, log=print):
     """Trains one policy with norm2tex.rl.ppo; returns (act, records, policy). act(obs) ->
     greedy actions for a batch of observations. log(record) per update."""
-    device = resolve_device(config.device)
+    device = use_device(config.device)
     env = make_env(condition, config, config.materials, config.train_variants, config.num_envs)
     try:
         torch.manual_seed(config.seed)
@@ -327,7 +311,7 @@ def train_condition_sb3(condition, config, log=print):
         def forward(self, obs):
             return self.encoder(obs)
 
-    device = resolve_device(config.device)
+    device = use_device(config.device)
     model = PPO("MultiInputPolicy", venv, n_steps=config.rollout_steps,
                 batch_size=config.rollout_steps * config.num_envs // config.minibatches,
                 n_epochs=config.update_epochs, learning_rate=config.learning_rate,
@@ -534,153 +518,6 @@ def write_results_csv(path, results):
                         w.writerow((p, m, k, "", repr(v)))
 
 
-PALETTE = {"wood": (166, 97, 26), "fabric": (44, 123, 182), "smooth": (77, 172, 38),
-           EMPTY: (110, 110, 110), "rock": (120, 60, 150), "print3d": (215, 48, 39)}
-POLICY_COLOURS = {"blind": (90, 90, 90), "textureless": (44, 123, 182),
-                  "norm2tex": (215, 48, 39)}
-
-
-def _colour(name, table, i):
-    fallback = [(27, 158, 119), (217, 95, 2), (117, 112, 179), (231, 41, 138)]
-    return table.get(name, fallback[i % len(fallback)])
-
-
-def _nice_ticks(lo, hi, count=5):
-    span = hi - lo
-    step = 10 ** math.floor(math.log10(span / count)) if span > 0 else 1.0
-    for m in (1, 2, 2.5, 5, 10):
-        if span / (step * m) <= count:
-            step *= m
-            break
-    first = math.ceil(lo / step) * step
-    return [first + k * step for k in range(int((hi - first) / step + 1e-9) + 1)]
-
-
-class _Panel:
-    """A plot area of a PIL image: data -> pixel coordinates, axes, ticks, labels."""
-
-    def __init__(self, draw, box, xlim, ylim, title, xlabel, ylabel, font):
-        self.draw, self.box, self.xlim, self.ylim, self.font = draw, box, xlim, ylim, font
-        x0, y0, x1, y1 = box
-        draw.rectangle(box, outline=(0, 0, 0))
-        draw.text((x0, y0 - 16), title, fill=(0, 0, 0), font=font)
-        draw.text(((x0 + x1) // 2 - 3 * len(xlabel), y1 + 20), xlabel, fill=(0, 0, 0), font=font)
-        draw.text((x0 - 52, y0 - 30), ylabel, fill=(0, 0, 0), font=font)
-        for t in _nice_ticks(*xlim):
-            px = self.x(t)
-            draw.line((px, y1, px, y1 + 4), fill=(0, 0, 0))
-            draw.text((px - 8, y1 + 6), ("%g" % t), fill=(0, 0, 0), font=font)
-        for t in _nice_ticks(*ylim):
-            py = self.y(t)
-            draw.line((x0 - 4, py, x0, py), fill=(0, 0, 0))
-            draw.line((x0 + 1, py, x1 - 1, py), fill=(232, 232, 232))
-            draw.text((x0 - 44, py - 6), ("%.3g" % t), fill=(0, 0, 0), font=font)
-
-    def x(self, v):
-        x0, _, x1, _ = self.box
-        return x0 + (v - self.xlim[0]) / (self.xlim[1] - self.xlim[0]) * (x1 - x0)
-
-    def y(self, v):
-        _, y0, _, y1 = self.box
-        v = min(max(v, self.ylim[0]), self.ylim[1])
-        return y1 - (v - self.ylim[0]) / (self.ylim[1] - self.ylim[0]) * (y1 - y0)
-
-    def line(self, xs, ys, colour, width=2, dash=None):
-        pts = [(self.x(a), self.y(b)) for a, b in zip(xs, ys)]
-        if dash:
-            x0, _, x1, _ = self.box
-            py = pts[0][1]
-            for a in range(int(x0), int(x1), 2 * dash):
-                self.draw.line((a, py, min(a + dash, x1), py), fill=colour, width=width)
-        elif len(pts) > 1:
-            self.draw.line(pts, fill=colour, width=width, joint="curve")
-
-
-def plot_openings(path, results, config):
-    """The paper's figure: opening vs step, a panel per policy, a curve per material (mean, and
-    a band of +- one standard deviation over the episodes), thresholds dashed."""
-    from PIL import Image, ImageDraw, ImageFont
-
-    font = ImageFont.load_default()
-    policies = list(results["policies"])
-    width, height, margin = 380, 300, 70
-    img = Image.new("RGB", (margin + len(policies) * (width + margin), height + 2 * margin + 40),
-                    "white")
-    values = [v for e in results["policies"].values() for ev in e["evaluation"].values()
-              for v in (np.array(ev["opening_mean"]) + np.array(ev["opening_std"])).tolist()
-              + (np.array(ev["opening_mean"]) - np.array(ev["opening_std"])).tolist()]
-    values += [t for t in results["thresholds"].values() if t is not None]
-    ylim = (min(0.4, min(values)), max(0.75, max(values)))
-    xlim = (0, config.horizon)
-    for k, p in enumerate(policies):
-        x0 = margin + k * (width + margin)
-        box = (x0, margin, x0 + width, margin + height)
-        overlay = Image.new("RGBA", img.size, (0, 0, 0, 0))
-        odraw = ImageDraw.Draw(overlay)
-        draw = ImageDraw.Draw(img)
-        panel = _Panel(draw, box, xlim, ylim, p, "step", "opening", font)
-        band = _Panel.__new__(_Panel)
-        band.draw, band.box, band.xlim, band.ylim = odraw, box, xlim, ylim
-        evaluation = results["policies"][p]["evaluation"]
-        for i, (m, ev) in enumerate(evaluation.items()):
-            c = _colour(m, PALETTE, i)
-            mean, std = np.array(ev["opening_mean"]), np.array(ev["opening_std"])
-            steps = np.arange(len(mean))
-            poly = ([(band.x(s), band.y(v)) for s, v in zip(steps, mean + std)]
-                    + [(band.x(s), band.y(v)) for s, v in zip(steps[::-1], (mean - std)[::-1])])
-            odraw.polygon(poly, fill=c + (50,))
-        img.paste(Image.alpha_composite(img.convert("RGBA"), overlay).convert("RGB"))
-        draw = ImageDraw.Draw(img)
-        panel.draw = draw
-        for i, (m, t) in enumerate(results["thresholds"].items()):
-            if t is not None:
-                panel.line([0, 1], [t, t], _colour(m, PALETTE, i), width=1, dash=6)
-        for i, (m, ev) in enumerate(evaluation.items()):
-            c = _colour(m, PALETTE, i)
-            panel.line(range(len(ev["opening_mean"])), ev["opening_mean"], c)
-        # Legend: curves, and what the dashed lines are.
-        for i, m in enumerate(evaluation):
-            c = _colour(m, PALETTE, i)
-            ly = box[3] - 14 * (len(evaluation) - i) - 4
-            draw.line((box[0] + 8, ly + 6, box[0] + 28, ly + 6), fill=c, width=3)
-            draw.text((box[0] + 32, ly), "%s  drop %.0f%%" % (m, 100 * evaluation[m]["drop_rate"]),
-                      fill=(0, 0, 0), font=font)
-    draw = ImageDraw.Draw(img)
-    draw.text((margin, img.size[1] - 30),
-              "mean +- std over %d held-out episodes per material; dashed: the material's drop "
-              "threshold (largest opening that holds the cube)" % config.eval_episodes,
-              fill=(0, 0, 0), font=font)
-    img.save(path)
-
-
-def plot_training(path, results, config):
-    """Mean training return (episodes finished in each update) vs environment steps."""
-    from PIL import Image, ImageDraw, ImageFont
-
-    font = ImageFont.load_default()
-    img = Image.new("RGB", (620, 420), "white")
-    draw = ImageDraw.Draw(img)
-    curves = {p: [(r["steps"], r["mean_return"]) for r in e["training"]
-                  if r.get("mean_return") is not None]
-              for p, e in results["policies"].items()}
-    ys = [y for c in curves.values() for _, y in c] or [0.0, 1.0]
-    lo, hi = min(ys), max(ys)
-    if hi - lo < 1e-6:
-        lo, hi = lo - 1.0, hi + 1.0
-    panel = _Panel(draw, (80, 50, 590, 350), (0, max(config.total_steps, 1)), (lo, hi),
-                   "PPO training: mean episode return", "environment steps", "return", font)
-    for i, (p, c) in enumerate(curves.items()):
-        colour = _colour(p, POLICY_COLOURS, i)
-        if c:
-            panel.line([s for s, _ in c], [y for _, y in c], colour)
-            if len(c) == 1:
-                x, y = panel.x(c[0][0]), panel.y(c[0][1])
-                draw.ellipse((x - 3, y - 3, x + 3, y + 3), fill=colour)
-        draw.line((96, 64 + 14 * i, 116, 64 + 14 * i), fill=colour, width=3)
-        draw.text((120, 58 + 14 * i), p, fill=(0, 0, 0), font=font)
-    img.save(path)
-
-
 # --- the experiment ----------------------------------------------------------------------------
 
 def run(config=None, out_dir="hold_cube_experiment", log=print):
@@ -693,8 +530,8 @@ def run(config=None, out_dir="hold_cube_experiment", log=print):
         raise ValueError("encoder %r; valid: %s" % (config.encoder, ", ".join(ENCODERS)))
     if config.algo == "sb3":
         require_sb3()
+    device = use_device(config.device)  # first: a missing GPU stops the run before any work
     os.makedirs(out_dir, exist_ok=True)
-    device = resolve_device(config.device)
     log("hold_cube_experiment: device %s, %d torch threads, %s" % (
         device, torch.get_num_threads(), json.dumps(_clean(asdict(config)))))
 
@@ -744,7 +581,7 @@ def run(config=None, out_dir="hold_cube_experiment", log=print):
     with open(os.path.join(out_dir, "results.json"), "w") as f:
         json.dump(results, f, indent=1, sort_keys=True)
     write_results_csv(os.path.join(out_dir, "results.csv"), results)
-    plot_openings(os.path.join(out_dir, "opening_vs_step.png"), results, config)
-    plot_training(os.path.join(out_dir, "training_curves.png"), results, config)
+    figures.plot_openings(os.path.join(out_dir, "opening_vs_step.png"), results, config)
+    figures.plot_training(os.path.join(out_dir, "training_curves.png"), results, config)
     log("wrote %s" % out_dir)
     return results

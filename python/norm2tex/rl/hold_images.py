@@ -20,20 +20,12 @@ import numpy as np
 import torch
 from torch import nn
 
+from norm2tex.blocks import block_mean
 from norm2tex.envs import HoldCubeVectorEnv
 from norm2tex.rl.hold_cube_experiment import IMAGE_GAIN, MATERIALS, SmallCNN
 
 HOLD_OPENING = 0.53
 STEP = 0.005
-
-
-def _shrink(images, factor):
-    if factor == 1:
-        return images
-    n, rows, cols, ch = images.shape
-    r, c = rows // factor * factor, cols // factor * factor
-    blocks = images[:, :r, :c].reshape(n, r // factor, factor, c // factor, factor, ch)
-    return blocks.mean(axis=(2, 4), dtype=np.float32)
 
 
 def hold_images(material, condition, variants, episodes, seed, opening=HOLD_OPENING, steps=24,
@@ -95,8 +87,8 @@ def material_separability(images, downscale, epochs=60, seed=0, lr=1e-3, batch=3
         left, right, labels = [], [], []
         for k, m in enumerate(materials):
             l, r = images[split][m]
-            left.append(_shrink(l, downscale))
-            right.append(_shrink(r, downscale))
+            left.append(block_mean(l, downscale))
+            right.append(block_mean(r, downscale))
             labels += [k] * len(l)
         return (_tensor(np.concatenate(left)), _tensor(np.concatenate(right)),
                 torch.as_tensor(labels))
