@@ -67,17 +67,6 @@ py::array_t<double> perJoint(const std::vector<int>& joints, const std::vector<d
   return out;
 }
 
-py::dict contactDict(const GelContactState& c) {
-  py::dict out;
-  out["in_contact"] = c.in_contact;
-  out["normal_force_n"] = c.normal_force_n;
-  out["shear_force_n"] = Eigen::Vector3d(c.shear_force_n);
-  out["penetration_m"] = c.penetration_m;
-  out["too_deep"] = c.too_deep;
-  out["object_in_gel"] = poseToNumpy(c.object_in_gel);
-  return out;
-}
-
 std::optional<Eigen::Isometry3d> optionalPose(const py::object& pose, const std::string& what) {
   if (pose.is_none()) return std::nullopt;
   return poseFromPython(pose, what);

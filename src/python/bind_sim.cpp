@@ -28,17 +28,6 @@ Finger fingerFrom(const std::string& name) {
   throw py::value_error("finger '" + name + "'; valid: left, right");
 }
 
-py::dict contactDict(const GelContactState& c) {
-  py::dict out;
-  out["in_contact"] = c.in_contact;
-  out["normal_force_n"] = c.normal_force_n;
-  out["shear_force_n"] = Eigen::Vector3d(c.shear_force_n);
-  out["penetration_m"] = c.penetration_m;
-  out["too_deep"] = c.too_deep;
-  out["object_in_gel"] = poseToNumpy(c.object_in_gel);
-  return out;
-}
-
 py::dict episodeDict(const EpisodeStart& s) {
   py::dict out;
   out["episode"] = s.episode;

@@ -1,5 +1,7 @@
 #include "numpy_conversions.hpp"
 
+#include <pybind11/eigen.h>
+
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -10,12 +12,18 @@ namespace {
 
 py::dtype dtypeOf(int depth) {
   switch (depth) {
-    case CV_8U: return py::dtype::of<std::uint8_t>();
-    case CV_16S: return py::dtype::of<std::int16_t>();
-    case CV_32S: return py::dtype::of<std::int32_t>();
-    case CV_32F: return py::dtype::of<float>();
-    case CV_64F: return py::dtype::of<double>();
-    default: throw std::invalid_argument("no numpy type for OpenCV depth " + std::to_string(depth));
+    case CV_8U:
+      return py::dtype::of<std::uint8_t>();
+    case CV_16S:
+      return py::dtype::of<std::int16_t>();
+    case CV_32S:
+      return py::dtype::of<std::int32_t>();
+    case CV_32F:
+      return py::dtype::of<float>();
+    case CV_64F:
+      return py::dtype::of<double>();
+    default:
+      throw std::invalid_argument("no numpy type for OpenCV depth " + std::to_string(depth));
   }
 }
 
@@ -40,11 +48,12 @@ cv::Mat fromNumpy(const py::handle& handle, int type, const std::string& what) {
     throw py::value_error(what + ": dtype " + std::string(py::str(array.dtype())) + ", expected " +
                           std::string(py::str(dtypeOf(depth))));
   }
-  const bool shape_ok = channels == 1 ? array.ndim() == 2
-                                      : array.ndim() == 3 && array.shape(2) == channels;
+  const bool shape_ok =
+      channels == 1 ? array.ndim() == 2 : array.ndim() == 3 && array.shape(2) == channels;
   if (!shape_ok) {
-    throw py::value_error(what + ": shape must be (rows, cols" +
-                          (channels == 1 ? std::string(")") : ", " + std::to_string(channels) + ")"));
+    throw py::value_error(
+        what + ": shape must be (rows, cols" +
+        (channels == 1 ? std::string(")") : ", " + std::to_string(channels) + ")"));
   }
   // C order, so that rows are contiguous (a copy only when the array is not).
   py::array c = py::array::ensure(array, py::array::c_style);
@@ -89,7 +98,8 @@ Eigen::Isometry3d poseFromPython(const py::handle& pose, const std::string& what
                      rotation.determinant() > 0.0 &&
                      matrix.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1));
   if (matrix.allFinite() && !rigid) {
-    throw py::value_error(what + ": not a rigid transform (rotation not orthonormal, or last row "
+    throw py::value_error(what +
+                          ": not a rigid transform (rotation not orthonormal, or last row "
                           "not 0 0 0 1)");
   }
   out.matrix() = matrix;
@@ -101,6 +111,17 @@ py::array_t<double> poseToNumpy(const Eigen::Isometry3d& pose) {
   auto m = out.mutable_unchecked<2>();
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) m(r, c) = pose.matrix()(r, c);
+  return out;
+}
+
+py::dict contactDict(const GelContactState& c) {
+  py::dict out;
+  out["in_contact"] = c.in_contact;
+  out["normal_force_n"] = c.normal_force_n;
+  out["shear_force_n"] = Eigen::Vector3d(c.shear_force_n);
+  out["penetration_m"] = c.penetration_m;
+  out["too_deep"] = c.too_deep;
+  out["object_in_gel"] = poseToNumpy(c.object_in_gel);
   return out;
 }
 

@@ -7,10 +7,12 @@
 
 #include <string>
 
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "norm2tex/sim/gripper_sim.hpp"
 
 namespace norm2tex {
 namespace python {
@@ -31,6 +33,11 @@ Eigen::Isometry3d poseFromPython(const py::handle& pose, const std::string& what
 
 /// A pose as a 4 x 4 float64 numpy array.
 py::array_t<double> poseToNumpy(const Eigen::Isometry3d& pose);
+
+/// What one gel feels, as the simulations' contact() returns it in Python: a dict of
+/// in_contact, normal_force_n, shear_force_n (gel frame), penetration_m, too_deep,
+/// object_in_gel (4x4).
+py::dict contactDict(const GelContactState& contact);
 
 }  // namespace python
 }  // namespace norm2tex
