@@ -135,7 +135,8 @@ def test_resnet18_is_torchvisions_shape_size_and_one_step():
 
 def test_resnet18_sees_two_pixel_stripes(export):
     need_torchvision()
-    result = train(export, downscale=1, arch="resnet18", epochs=2)  # 100 % here, ~10 s
+    # 4 epochs: 2 reach 100 % with Debian 12's torch 1.13 but only 72 % with Debian 11's 1.7.
+    result = train(export, downscale=1, arch="resnet18", epochs=4)
     assert result["settings"]["arch"] == "resnet18"
     assert result["settings"]["parameters"] == 11177538  # torchvision's, for two classes
     assert result["overall"]["accuracy"] >= 0.9, result["confusion"]
