@@ -10,13 +10,6 @@
 #include "sim/tactile_options.hpp"
 
 namespace norm2tex {
-namespace {
-
-/// Variants a gripper keeps generated when it has a cache of its own (the paper rotates 24).
-constexpr std::size_t kKeptVariants = 32;
-
-}  // namespace
-
 void validate(const TactileGripperOptions& o) {
   detail::validateTactileOptions(o, "tactile gripper option");
 }
@@ -41,7 +34,7 @@ TactileGripper::TactileGripper(GripperSimConfig scene, const SensorModel& sensor
   // Beta 0 renders textureless (nothing to generate).
   beta_mm_ = setup.beta_mm;
   if (beta_mm_ > 0.0) {
-    if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(kKeptVariants);
+    if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(detail::kKeptVariants);
     useVariant(variant_);
   } else {
     for (auto& renderer : renderers_) renderer->setObject(mesh_);

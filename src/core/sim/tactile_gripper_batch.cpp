@@ -6,18 +6,16 @@
 #include <string>
 
 #include "norm2tex/common/error.hpp"
+#include "sim/tactile_options.hpp"
 
 namespace norm2tex {
 namespace {
 
-/// Variants the batch keeps generated, per material of its grippers: the paper's 24, with room.
-constexpr std::size_t kKeptVariants = 32;
-
-/// The cache's capacity: kKeptVariants for each distinct material of the grippers.
+/// The cache's capacity: detail::kKeptVariants for each distinct material of the grippers.
 std::size_t keptVariants(const std::vector<TactileGripperOptions>& options) {
   std::set<std::string> materials;
   for (const TactileGripperOptions& o : options) materials.insert(o.material_config);
-  return kKeptVariants * std::max<std::size_t>(1, materials.size());
+  return detail::kKeptVariants * std::max<std::size_t>(1, materials.size());
 }
 
 }  // namespace

@@ -12,13 +12,6 @@
 #include "sim/tactile_options.hpp"
 
 namespace norm2tex {
-namespace {
-
-/// Variants a hand keeps generated when it has a cache of its own.
-constexpr std::size_t kKeptVariants = 32;
-
-}  // namespace
-
 void validate(const TactileHandOptions& o) {
   detail::validateTactileOptions(o, "tactile hand option");
   if (o.render_threads < 0 || o.render_threads > 256) {
@@ -59,7 +52,7 @@ TactileHand::TactileHand(HandSimConfig config, const SensorModel& sensor,
 
   beta_mm_ = setup.beta_mm;
   if (beta_mm_ > 0.0) {
-    if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(kKeptVariants);
+    if (!textures_) textures_ = std::make_shared<ObjectTextureCache>(detail::kKeptVariants);
     const std::shared_ptr<const ObjectTexture> texture = detail::objectTextureVariant(
         *textures_, options_.material_config, options_.material_seed, variant_, mesh_);
     for (auto& renderer : renderers_) renderer->setObject(mesh_, texture->atlas, beta_mm_);

@@ -50,6 +50,10 @@ void validateTactileOptions(const Options& o, const std::string& what) {
   }
 }
 
+/// Texture variants a simulation keeps generated when it has a cache of its own (the paper
+/// rotates 24).
+constexpr std::size_t kKeptVariants = 32;
+
 /// The shared options resolved as the ROS system resolves them (contact_sim, tactile_renderer).
 struct TactileSetup {
   std::optional<MaterialConfig> material;
