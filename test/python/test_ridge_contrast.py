@@ -44,6 +44,29 @@ def test_the_curve_is_flat_without_conformity_and_rises_with_a_stiff_gel():
     assert stiff["real_shape"][-1] == 1.0 and stiff["real_shape"][0] == pytest.approx(1.2 / 3.8)
 
 
+def test_the_shipped_gel_follows_the_real_curve_and_a_gel_without_its_coating_does_not():
+    # The realism goal: the shape (contrast / contrast at 11.9 N) within 0.1 of the real unit's
+    # at every force from 5 to 11.9 N, with the shipped sensor (its coating, 0.20 mm). Without
+    # the coating the gel follows the ridges fully from 4 N and the curve is flat.
+    shipped, _ = run_script()
+    assert shipped["coating_length_mm"] == pytest.approx(0.20)
+    assert shipped["largest_shape_difference"] <= 0.1, shipped["shape"]
+    assert shipped["contrast"] == sorted(shipped["contrast"])  # grows to the firmest press
+    bare, _ = run_script("--coating-length-mm", "0")
+    assert bare["largest_shape_difference"] > 0.3, bare["shape"]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--coating-length-mm", "-0.1"], "coating_length_mm"),
+    (["--contact-modulus-mpa", "0"], "contact_modulus_mpa"),
+])
+def test_out_of_range_gel_options_are_clear_errors(args, message):
+    done = subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 1 and message in done.stderr and "Traceback" not in done.stderr, \
+        done.stderr
+
+
 def test_bad_dimensions_are_refused():
     done = subprocess.run([sys.executable, SCRIPT, "--pitch-mm", "0"], capture_output=True,
                           text=True, timeout=60)

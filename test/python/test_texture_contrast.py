@@ -4,7 +4,7 @@ Needs the devel (or install) space's environment: `import norm2tex` must find th
 module. A flat face covers the whole imaged gel at every force, so the contact is the same at
 2, 5 and 12 N: with the fixed-depth overlay the texture in the image cannot depend on the
 force, and with the conformity model it must grow with the pressure until the gel follows all of
-the relief (Johnson: p* = pi E* Delta / lambda).
+the relief (Johnson: p* = pi E* Delta / lambda, times 1 + (2 pi l / lambda)^3 for the coating).
 """
 
 import json
@@ -38,17 +38,33 @@ def test_conformity_makes_the_texture_grow_with_force_and_the_overlay_does_not()
     for material in ("rock", "fabric"):
         rms_on = np.array(on["materials"][material]["rms_mean"])
         rms_off = np.array(off["materials"][material]["rms_mean"])
-        assert np.all(np.isfinite(rms_on)) and np.all(rms_on > 0.5), (material, rms_on)
+        assert np.all(np.isfinite(rms_on)) and np.all(rms_on > 0.1), (material, rms_on)
         # Fixed depth: the same texture at every force (the face is in contact all over).
         assert np.ptp(rms_off) < 0.02 * rms_off.mean(), (material, rms_off)
-        # Conformity: a light press shows clearly less, never more, than a firm one ...
-        assert rms_on[0] < 0.85 * rms_on[2], (material, rms_on)
+        # Conformity: a light press shows less, never more, than a firm one (rock's coarse
+        # relief is followed from 2 N, its fine roughness not even at 12 N: below) ...
+        assert rms_on[0] < 0.97 * rms_on[2], (material, rms_on)
         assert rms_on[0] <= rms_on[1] * 1.01 and rms_on[1] <= rms_on[2] * 1.01, (material, rms_on)
         # ... and at most what the fixed-depth overlay shows (the full relief).
         assert np.all(rms_on <= rms_off * 1.02), (material, rms_on, rms_off)
-    # Rock's fine roughness needs more pressure than fabric's weave: still growing from 5 N.
-    rock = on["materials"]["rock"]["rms_mean"]
-    assert rock[2] > rock[1] * 1.05, rock
+
+
+def test_the_coating_holds_fine_relief_back_to_a_firm_press():
+    # Without the coating (Johnson's half-space) fabric's weave is followed fully from a medium
+    # press on; the shipped coating (a plate on the gel: p* times 1 + (2 pi l / lambda)^3) makes
+    # the same weave need far more pressure, so it is still growing at a firm one. Coarse relief
+    # is held back much less: rock's texture at 12 N keeps more of its bare value than fabric's.
+    coated, _ = run_script("--materials", "rock,fabric")
+    bare, _ = run_script("--materials", "rock,fabric", "--coating-length-mm", "0")
+    assert coated["coating_length_mm"] == pytest.approx(0.20) and bare["coating_length_mm"] == 0
+    fabric_bare = np.array(bare["materials"]["fabric"]["rms_mean"])
+    fabric_coated = np.array(coated["materials"]["fabric"]["rms_mean"])
+    assert fabric_bare[2] == pytest.approx(fabric_bare[1], rel=0.02), fabric_bare
+    assert fabric_coated[2] > 1.5 * fabric_coated[1] > 1.5 * fabric_coated[0], fabric_coated
+    assert np.all(fabric_coated < fabric_bare), (fabric_coated, fabric_bare)
+    kept = {m: coated["materials"][m]["rms_mean"][2] / bare["materials"][m]["rms_mean"][2]
+            for m in ("rock", "fabric")}
+    assert kept["fabric"] < kept["rock"], kept
 
 
 def test_the_figure_is_written():
@@ -69,6 +85,7 @@ def test_the_figure_is_written():
     (["--forces", "2,-1"], "finite and > 0"),
     (["--forces", "two"], "newtons"),
     (["--variants", "0"], "--variants"),
+    (["--coating-length-mm", "3"], "coating_length_mm"),
 ])
 def test_bad_arguments_are_clear_errors(args, message):
     done = subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True,

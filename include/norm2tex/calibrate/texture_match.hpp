@@ -62,6 +62,9 @@ struct TextureMatchResult {
   double start_beta_mm = 0.0;
   double beta_mm = 0.0;
   bool beta_at_bound = false;  ///< the searched range's end: the frames want beta outside it
+  /// No depth in the searched range matched the frames better than the material's own: beta is
+  /// start_beta_mm (the frames' texture too faint to pin it; a warning says so).
+  bool beta_kept = false;
   /// RMS over the frames of ln(sim RMS / real RMS): 0.05 is a 5 % misfit.
   double misfit = 0.0;
   double start_misfit = 0.0;   ///< the same at start_beta_mm

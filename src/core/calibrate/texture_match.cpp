@@ -19,6 +19,7 @@ constexpr double kMaxBetaMm = 2.0;    // validate(MaterialConfig)'s bound
 constexpr double kRmsFloor = 0.05;    // grey levels: a band below it counts as this (no log 0)
 constexpr int kDepthIterations = 12;
 constexpr int kBetaIterations = 9;  // within a 2x bracket: to 0.14 %
+constexpr double kSlopeStep = 1.25;  // beta's step that measures which way the texture goes
 constexpr int kModulusRefinements = 8;
 // E* grid (MPa): soft silicone to stiff rubber; the shipped gel's is 0.1.
 const double kModulusGrid[] = {0.02, 0.035, 0.06, 0.1, 0.18, 0.32, 0.56, 1.0};
@@ -145,18 +146,26 @@ class TextureMatcher::Session {
   }
 
   // The beta where the mean log ratio crosses 0, nearest the current one: bracketed by steps of
-  // 2x from it (up while the simulation shows too little texture, down while too much), then
-  // bisected on ln beta. Monotone near the root, but not globally: grooves much deeper than the
-  // press leave the gel untouched, so a far too deep texture shows less, not more, and a search
-  // over the whole range could settle there. Leaves the session at the result; returns
-  // {beta, misfit}.
+  // 2x from it towards the root, then bisected on ln beta. Which way is towards the root depends
+  // on the local slope, measured first: a relief the gel follows fully shows more texture the
+  // deeper it is, but one it follows only on its crests (a light press, or short wavelengths
+  // under the coating, whose p* grows with the depth) shows less, since the gel touches fewer,
+  // narrower crests. Not globally monotone either way (grooves much deeper than the press leave
+  // the gel untouched), so a search over the whole range could settle on a far root. Leaves the
+  // session at the result; returns {beta, misfit}.
   cv::Vec2d fitBeta(double lo, double hi, bool* at_bound) {
     double a = std::clamp(beta_mm_, lo, hi);
+    *at_bound = false;
+    const double probe = a < hi ? std::min(a * kSlopeStep, hi) : std::max(a / kSlopeStep, lo);
+    setBeta(probe);
+    const double probe_ratio = logRatios()[0];
     setBeta(a);
     cv::Vec2d ratios = logRatios();
-    const bool up = ratios[0] < 0.0;
+    // ln(sim / real) grows with beta here (more texture for a deeper relief) or falls.
+    const bool grows = (probe_ratio - ratios[0]) * (probe - a) >= 0.0;
+    const bool up = (ratios[0] < 0.0) == grows;
+    const bool start_below = ratios[0] < 0.0;
     double b = a;
-    *at_bound = false;
     for (;;) {
       const double next = up ? std::min(b * 2.0, hi) : std::max(b * 0.5, lo);
       if (next == b) {  // at the range's end, still on the same side
@@ -166,15 +175,16 @@ class TextureMatcher::Session {
       a = b, b = next;
       setBeta(b);
       ratios = logRatios();
-      if ((ratios[0] < 0.0) != up) break;
+      if ((ratios[0] < 0.0) != start_below) break;
     }
-    double below = std::log(std::min(a, b)), above = std::log(std::max(a, b));
+    // `a` is on the start's side of the root, `b` past it.
+    double on_start_side = std::log(a), past = std::log(b);
     for (int k = 0; k < kBetaIterations; ++k) {
-      const double mid = 0.5 * (below + above);
+      const double mid = 0.5 * (on_start_side + past);
       setBeta(std::exp(mid));
-      (logRatios()[0] < 0.0 ? below : above) = mid;
+      ((logRatios()[0] < 0.0) == start_below ? on_start_side : past) = mid;
     }
-    setBeta(std::exp(0.5 * (below + above)));
+    setBeta(std::exp(0.5 * (on_start_side + past)));
     return {beta_mm_, logRatios()[1]};
   }
 
@@ -376,6 +386,19 @@ TextureMatchResult TextureMatcher::fit(const std::vector<TextureFrame>& frames) 
 
   result.contact_modulus_note = session.fitModulus(lo, hi, fit, result.beta_at_bound);
   result.contact_modulus_fitted = session.modulus() != model_.conformity.contact_modulus_mpa;
+  if (!result.contact_modulus_fitted && fit[1] > result.start_misfit) {
+    // Where the mean log ratio crosses 0 need not lower the misfit: frames whose texture is
+    // under their noise (fine relief the gel's coating holds back) put it anywhere. Fitting
+    // then says nothing, and the material's own beta is the honest answer.
+    session.setBeta(sample_.beta_mm);
+    fit = {sample_.beta_mm, session.logRatios()[1]};
+    result.beta_at_bound = false;
+    result.beta_kept = true;
+    result.warnings.push_back(
+        "beta kept at the material's " + number(sample_.beta_mm) + " mm: no other depth in " +
+        number(lo) + "-" + number(hi) + " mm matches the frames better (their texture is too " +
+        "faint to pin it: press harder, or the gel holds this relief back)");
+  }
   result.beta_mm = fit[0];
   result.misfit = fit[1];
   result.contact_modulus_mpa = session.modulus();
