@@ -369,6 +369,35 @@ TEST(ConformityRender, OffIsTheFixedDepthOverlayBitForBit) {
   }
 }
 
+TEST(ConformityRender, TheCoatingLeavesAnUntexturedPressAsItWas) {
+  // The coating only changes how much texture the gel follows: a ball without texture (what
+  // the calibration fits) renders bit for bit as without a coating, at any force.
+  SensorModel coated = makeDigitSensorModel();
+  ASSERT_DOUBLE_EQ(coated.conformity.coating_length_mm, 0.20) << "the shipped coating";
+  SensorModel bare = coated;
+  bare.conformity.coating_length_mm = 0.0;
+  const auto ball = std::make_shared<const TexturedMesh>(makeUvSphere(3e-3, 96, 192));
+  TactileRenderer with(coated), without(bare);
+  with.setObject(ball);
+  without.setObject(ball);
+  for (double press_mm : {0.3, 1.2}) {
+    const auto pose = poseMm(0.4, -0.9, 3.0 - press_mm);
+    const double force = GelLaw::taximDefault().force(press_mm * 1e-3);
+    const cv::Mat3b image = with.render(pose, 3, force).image.clone();
+    EXPECT_EQ(cv::norm(image, without.render(pose, 3, force).image, cv::NORM_INF), 0.0)
+        << "press " << press_mm;
+  }
+  // ... while the same ball with a texture shows less of it through the coating.
+  const auto atlas = randomAtlas(1.0);
+  with.setObject(ball, atlas, 0.05);
+  without.setObject(ball, atlas, 0.05);
+  const auto pose = poseMm(0.0, 0.0, 3.0 - 0.5);
+  const double force = GelLaw::taximDefault().force(0.5e-3);
+  EXPECT_GT(cv::norm(with.render(pose, 3, force).image, without.render(pose, 3, force).image,
+                     cv::NORM_INF),
+            0.0);
+}
+
 TEST(ConformityRender, OnIsTheStagesInARowWithTheFollowedRelief) {
   // The renderer's one-pass path (GelConformity::applyToFinal) gives what the overlay, then
   // apply()'s followed relief in place of beta H_local, then the gel and the shading give.
