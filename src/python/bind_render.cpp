@@ -107,6 +107,11 @@ void bindRender(py::module& m) {
           [](SensorModel& s, double l) { s.conformity.coating_length_mm = l; },
           "the coating's bending length, mm: relief of wavelength L needs (1 + (2 pi l / L)^3) "
           "times Johnson's pressure (0: no coating)")
+      .def_property(
+          "slope_saturation",
+          [](const SensorModel& s) { return s.shading.slope_saturation; },
+          [](SensorModel& s, double v) { s.shading.slope_saturation = v; },
+          "the slope at which the calibrated shading's slope features saturate (0: none)")
       .def_readwrite("background_image", &SensorModel::background_image,
                      "no-contact frame (bgr image file); empty: the synthetic background")
       .def_property_readonly(

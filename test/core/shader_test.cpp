@@ -400,7 +400,7 @@ TEST(ShaderResponseTest, FeaturesOfAParaboloidMatchItsDerivatives) {
   }
   ShadingFeatureArray f;
   const cv::Rect box(0, 0, model.cols, model.rows);
-  computeShadingFeatures(h, model.mm_per_pixel, sigma, box, f);
+  computeShadingFeatures(h, model.mm_per_pixel, model.shading, box, f);
   const int margin = shadingReachPixels(model.mm_per_pixel, sigma) + 2;
   double worst_slope = 0.0, worst_rim = 0.0, worst_blur_slope = 0.0;
   for (int r = margin; r < model.rows - margin; r += 3) {
@@ -426,6 +426,58 @@ TEST(ShaderResponseTest, FeaturesOfAParaboloidMatchItsDerivatives) {
   EXPECT_LT(worst_blur_slope, 0.02 * 2 * b * 6.0);     // 2 % of the largest slope
 }
 
+// With slope_saturation s the slope features are g / sqrt(1 + |g|^2 / s^2) of the same
+// paraboloid (s = 1: the normal's tangential components), and so are the blurred field's slopes
+// (rim_right ... rim_up); depth and rim_out/rim_in are unchanged. The fused shading equals the
+// features times the response with it too.
+TEST(ShaderResponseTest, SaturatedSlopesAreTheNormalsComponents) {
+  SensorModel model = makeDigitSensorModel();
+  const double b = 0.3;  // slopes up to ~5 at the image's corners: well into the saturation
+  cv::Mat1f h(model.rows, model.cols);
+  for (int r = 0; r < model.rows; ++r) {
+    for (int c = 0; c < model.cols; ++c) {
+      const cv::Point2d p = model.pixelToGelMm(r, c);
+      h(r, c) = static_cast<float>(40.0 - b * (p.x * p.x + p.y * p.y));
+    }
+  }
+  const cv::Rect box(0, 0, model.cols, model.rows);
+  ShadingFeatureArray plain, saturated;
+  computeShadingFeatures(h, model.mm_per_pixel, model.shading, box, plain);
+  for (const double s : {1.0, 0.4}) {
+    model.shading.slope_saturation = s;
+    computeShadingFeatures(h, model.mm_per_pixel, model.shading, box, saturated);
+    double worst = 0.0, worst_blurred = 0.0;
+    for (int r = 2; r < model.rows - 2; r += 5) {
+      for (int c = 2; c < model.cols - 2; c += 5) {
+        const cv::Point2d p = model.pixelToGelMm(r, c);
+        const double gx = -2 * b * p.x, gy = -2 * b * p.y;
+        const double k = 1.0 / std::sqrt(1.0 + (gx * gx + gy * gy) / (s * s));
+        const double u = (c + 0.5) / (0.5 * model.cols) - 1.0;
+        const auto at = [&](int j) { return static_cast<double>(saturated[j](r, c)); };
+        worst = std::max({worst, std::abs(at(0) - k * gx), std::abs(at(1) - k * gy),
+                          std::abs(at(3) - k * k * gx * gy), std::abs(at(14) - k * gy * u)});
+        EXPECT_EQ(saturated[5](r, c), plain[5](r, c));
+        EXPECT_EQ(saturated[7](r, c), plain[7](r, c));
+        EXPECT_LE(std::hypot(at(0), at(1)), s * (1.0 + 1e-5));
+        EXPECT_LE(std::hypot(at(8) - at(9), at(10) - at(11)), s * (1.0 + 1e-5));
+        if (r > 40 && r < model.rows - 40 && c > 40 && c < model.cols - 40) {
+          // Away from the border the blurred paraboloid's slopes are the paraboloid's.
+          worst_blurred = std::max({worst_blurred, std::abs(at(8) - at(9) - k * gx),
+                                    std::abs(at(10) - at(11) - k * gy)});
+        }
+      }
+    }
+    EXPECT_LT(worst, 2e-4) << "s = " << s;
+    EXPECT_LT(worst_blurred, 0.05 * s) << "s = " << s;  // the reduced-resolution blur
+    // The renderer's fused path: the same shading (up to float rounding).
+    model.shading.response_bgr = defaultShadingResponse();
+    cv::Mat3f fused, applied;
+    computeShadingDifference(h, model.mm_per_pixel, model.shading, box, fused);
+    applyShadingResponse(saturated, model.shading, applied);
+    EXPECT_LT(cv::norm(fused, applied, cv::NORM_INF), 1e-3 * cv::norm(applied, cv::NORM_INF));
+  }
+}
+
 // The shader applies exactly the response: a unit coefficient on one feature reproduces that
 // feature in that channel, the others stay 0; the response is linear.
 TEST(ShaderResponseTest, ShaderAppliesTheResponseToTheFeatures) {
@@ -434,7 +486,7 @@ TEST(ShaderResponseTest, ShaderAppliesTheResponseToTheFeatures) {
   const cv::Mat1f h = smoothed(sphericalCap(model, 3.0, 0.4, 1.0, 2.0), model, 0.2);
   ShadingFeatureArray f;
   const cv::Rect box(0, 0, model.cols, model.rows);
-  computeShadingFeatures(h, model.mm_per_pixel, model.shading.shadow_sigma_mm, box, f);
+  computeShadingFeatures(h, model.mm_per_pixel, model.shading, box, f);
   for (const int feature : {0, 4, 6, 10, 19}) {
     model.shading.response_bgr = {};
     model.shading.response_bgr[2][feature] = 1.0;

@@ -19,7 +19,9 @@ namespace norm2tex {
 /// shadow_sigma_mm, bx, by its slopes, and u, v the pixel's position in [-1, 1] (image left /
 /// top to right / bottom):
 ///
-///    0-1  slope_x, slope_y             gx, gy: the first-order response to the normal
+///    0-1  slope_x, slope_y             gx, gy: the first-order response to the normal (with
+///                                      slope_saturation s > 0, both times
+///                                      1 / sqrt(1 + (gx^2 + gy^2) / s^2), in 2-4 and 12-15 too)
 ///    2-4  slope_xx, slope_xy, slope_yy gx^2, gx gy, gy^2: second order (wide secondary-colour
 ///                                      zones of a real hue wheel)
 ///    5    depth                        H / 1 mm: the flat centre brightens or darkens by unit
@@ -60,10 +62,12 @@ std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse()
 int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm);
 
 /// Features of `gel_mm` (CV_32FC1, image size, finite) over `box` (inside the image), as
-/// box-sized planes (reallocated only when the box size changes). One-sided differences at the
-/// image border; the blur replicates the border.
-void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double shadow_sigma_mm,
-                            const cv::Rect& box, ShadingFeatureArray& features);
+/// box-sized planes (reallocated only when the box size changes), with the shading's
+/// shadow_sigma_mm and slope_saturation. One-sided differences at the image border; the blur
+/// replicates the border.
+void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel,
+                            const ShadingOptions& shading, const cv::Rect& box,
+                            ShadingFeatureArray& features);
 
 /// diff (CV_32FC3, box-sized) = gain * response applied to the features.
 void applyShadingResponse(const ShadingFeatureArray& features, const ShadingOptions& shading,

@@ -35,6 +35,11 @@ struct ShadingOptions {
   std::array<std::array<double, kShadingFeatureCount>, 3> response_bgr{};
   /// Width (mm) of the blur whose spill past the contact rim carries the rim-shadow features.
   double shadow_sigma_mm = 0.6;
+  /// The slope s at which the slope features saturate: each takes g / sqrt(1 + |g|^2 / s^2)
+  /// for the gel's slope g (mm/mm), so steep flanks of a deep press answer less than linearly;
+  /// s = 1 makes them the gel normal's tangential components (a Lambertian surface's light is
+  /// linear in the normal, not in the slope). 0: the slopes themselves (no saturation).
+  double slope_saturation = 0.0;
 };
 
 /// Pixel noise added to a frame. A captured background already carries the sensor's noise, so

@@ -63,7 +63,7 @@ void accumulate(const SensorModel& model, const PressObservation& press, const c
   if (!box.empty()) {
     box = cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
           image;
-    computeShadingFeatures(gel, model.mm_per_pixel, model.shading.shadow_sigma_mm, box, features);
+    computeShadingFeatures(gel, model.mm_per_pixel, model.shading, box, features);
   }
   const double radius = kFitRegionRadii * press.circle.radius_px;
   const cv::Point2d centre = press.circle.centre_px;
@@ -129,7 +129,8 @@ void accumulate(const SensorModel& model, const PressObservation& press, const c
   }
 }
 
-ShadingFit solve(const NormalEquations& eq, const PressGeometry& geometry, double shadow_sigma_mm) {
+ShadingFit solve(const NormalEquations& eq, const PressGeometry& geometry,
+                 const ShadingOptions& features) {
   cv::Matx<double, kF, kF> a = eq.a;
   double trace = 0.0;
   for (int i = 0; i < kF; ++i) {
@@ -144,7 +145,8 @@ ShadingFit solve(const NormalEquations& eq, const PressGeometry& geometry, doubl
   fit.geometry = geometry;
   fit.shading.kind = ShadingKind::kCalibrated;
   fit.shading.gain = 1.0;
-  fit.shading.shadow_sigma_mm = shadow_sigma_mm;
+  fit.shading.shadow_sigma_mm = features.shadow_sigma_mm;
+  fit.shading.slope_saturation = features.slope_saturation;  // the features fitted with
   double sse = 0.0, sst = 0.0;
   for (int k = 0; k < 3; ++k) {
     double c_b = 0.0, c_a_c = 0.0;
@@ -227,7 +229,7 @@ ShadingFit fitShadingResponse(const SensorModel& base, const std::vector<PressOb
     eq.y_sum += press.y_sum;
     eq.count += press.count;
   }
-  ShadingFit fit = solve(eq, geometry, shadow_sigma_mm);
+  ShadingFit fit = solve(eq, geometry, model.shading);
   fit.gel = base.gel;
   return fit;
 }

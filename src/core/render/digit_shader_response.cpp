@@ -180,6 +180,21 @@ const ShadeRow shadeRow = shadeRowBaseline;
 const Differences differences = differencesBaseline;
 #endif
 
+// 1 / s^2 for the shading's slope_saturation s, 0 for none.
+float slopeSaturationFactor(const ShadingOptions& shading) {
+  const double s = shading.slope_saturation;
+  return s > 0.0 ? static_cast<float>(1.0 / (s * s)) : 0.0f;
+}
+
+// g <- g / sqrt(1 + |g|^2 / s^2) for n pixels' slopes (a plain loop the compiler vectorises).
+void saturateSlopes(int n, float inv_saturation_sq, float* __restrict gx, float* __restrict gy) {
+  for (int i = 0; i < n; ++i) {
+    const float scale = 1.0f / std::sqrt(1.0f + (gx[i] * gx[i] + gy[i] * gy[i]) * inv_saturation_sq);
+    gx[i] *= scale;
+    gy[i] *= scale;
+  }
+}
+
 }  // namespace
 
 std::string shadingFeatureNames() {
@@ -212,8 +227,11 @@ int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm) {
   return blurRadiusPixels(mm_per_pixel, shadow_sigma_mm) + 2;
 }
 
-void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double shadow_sigma_mm,
-                            const cv::Rect& box, ShadingFeatureArray& features) {
+void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel,
+                            const ShadingOptions& shading, const cv::Rect& box,
+                            ShadingFeatureArray& features) {
+  const double shadow_sigma_mm = shading.shadow_sigma_mm;
+  const float inv_saturation_sq = slopeSaturationFactor(shading);
   if ((box & cv::Rect(0, 0, gel_mm.cols, gel_mm.rows)) != box || box.empty()) {
     throw Error("computeShadingFeatures: box outside the image");
   }
@@ -247,8 +265,9 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
       const int c = box.x + i;
       const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, last_col);
       const float dx_scale = inv_pixel / static_cast<float>(c1 - c0);
-      const float gx = (mid[c1] - mid[c0]) * dx_scale;
-      const float gy = (down[c] - up[c]) * dy_scale;
+      float gx = (mid[c1] - mid[c0]) * dx_scale;
+      float gy = (down[c] - up[c]) * dy_scale;
+      if (inv_saturation_sq > 0.0f) saturateSlopes(1, inv_saturation_sq, &gx, &gy);
       const int bc = c - region.x, bc0 = c0 - region.x, bc1 = c1 - region.x;
       out[0][i] = gx;
       out[1][i] = gy;
@@ -259,8 +278,9 @@ void computeShadingFeatures(const cv::Mat1f& gel_mm, double mm_per_pixel, double
       const float rim = b_mid[bc] - mid[c];
       out[6][i] = std::max(rim, 0.0f);
       out[7][i] = std::min(rim, 0.0f);
-      const float bx = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
-      const float by = (b_down[bc] - b_up[bc]) * dy_scale;
+      float bx = (b_mid[bc1] - b_mid[bc0]) * dx_scale;
+      float by = (b_down[bc] - b_up[bc]) * dy_scale;
+      if (inv_saturation_sq > 0.0f) saturateSlopes(1, inv_saturation_sq, &bx, &by);
       out[8][i] = std::max(bx, 0.0f);
       out[9][i] = std::max(-bx, 0.0f);
       out[10][i] = std::max(by, 0.0f);
@@ -288,6 +308,7 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
   const int last_row = gel_mm.rows - 1, last_col = gel_mm.cols - 1;
   const float inv_half_cols = 2.0f / gel_mm.cols, inv_half_rows = 2.0f / gel_mm.rows;
   const double sigma_mm = shading.shadow_sigma_mm;
+  const float inv_saturation_sq = slopeSaturationFactor(shading);
   const int radius = blurRadiusPixels(mm_per_pixel, sigma_mm);
   cv::Rect region(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
                   box.height + 2 * radius + 2);
@@ -365,6 +386,10 @@ void computeShadingDifference(const cv::Mat1f& gel_mm, double mm_per_pixel,
     const float v = (r + 0.5f) * inv_half_rows - 1.0f;
     for (int c = 0; c < 3; ++c) {
       for (int q = 0; q < kVarying; ++q) k.a[c][q] = w[c][base[q]] + w[c][u_term[q] + 1] * v;
+    }
+    if (inv_saturation_sq > 0.0f) {
+      saturateSlopes(width, inv_saturation_sq, gx, gy);
+      saturateSlopes(width, inv_saturation_sq, bx, by);
     }
     shadeRow(width, gx, gy, hh, rim, bx, by, u0, inv_half_cols, k, out_b, out_g, out_r);
     cv::Vec3f* row = diff.ptr<cv::Vec3f>(j);

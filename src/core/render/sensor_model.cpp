@@ -40,7 +40,7 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
       {"gel", {"thickness_mm", "curvature_radius_mm", "pad_width_mm", "pad_height_mm"}},
       {"camera", {"fx", "fy", "cx", "cy"}},
       {"leds[]", {"name", "position_mm", "color_bgr", "intensity"}},
-      {"shading", {"model", "gain", "shadow_sigma_mm", "response"}},
+      {"shading", {"model", "gain", "shadow_sigma_mm", "slope_saturation", "response"}},
       {"shading.response", {"blue", "green", "red"}},
       {"noise",
        {"sigma_bgr", "neighbour_correlation", "correlation_bg", "correlation_gr", "correlation_br",
@@ -98,6 +98,7 @@ void readShading(const YAML::Node& node, ShadingOptions& shading) {
   shading.kind = parseShadingKind(kind);
   read(node, "gain", shading.gain);
   read(node, "shadow_sigma_mm", shading.shadow_sigma_mm);
+  read(node, "slope_saturation", shading.slope_saturation);
   if (const YAML::Node response = node["response"]) {
     rejectUnknownKeys(response, "shading.response");
     for (int k = 0; k < 3; ++k) {
@@ -179,6 +180,9 @@ void validate(const SensorModel& m) {
   requireParameter(s.gain >= 0.0 && s.gain <= 100.0, "shading.gain", s.gain, "[0, 100]");
   requireParameter(s.shadow_sigma_mm >= 0.05 && s.shadow_sigma_mm <= 3.0, "shading.shadow_sigma_mm",
                    s.shadow_sigma_mm, "[0.05, 3] mm");
+  requireParameter(s.slope_saturation == 0.0 ||
+                       (s.slope_saturation >= 0.05 && s.slope_saturation <= 20.0),
+                   "shading.slope_saturation", s.slope_saturation, "0 (none) or [0.05, 20]");
   for (int k = 0; k < 3; ++k) {
     for (const double value : s.response_bgr[k]) {
       requireParameter(std::isfinite(value) && std::abs(value) <= 1e5,
@@ -324,6 +328,7 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
   }
   out << "shading:\n  model: " << shadingKindName(m.shading.kind) << "\n  gain: " << m.shading.gain
       << "\n  shadow_sigma_mm: " << m.shading.shadow_sigma_mm
+      << "\n  slope_saturation: " << m.shading.slope_saturation
       << "\n  response:   # grey levels per unit of: " << shadingFeatureNames() << "\n";
   for (int k = 0; k < 3; ++k) {
     out << "    " << kChannelNames[k] << ": [";
