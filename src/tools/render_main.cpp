@@ -20,6 +20,7 @@
 #include "norm2tex/materials/material_texture.hpp"
 #include "norm2tex/mesh/mesh_primitives.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
+#include "norm2tex/render/contact_difference.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/tactile_renderer.hpp"
 #include "package_paths.hpp"
@@ -38,6 +39,7 @@ norm2tex::cli::Program makeProgram() {
       "                       [--material NAME] [--sensor digit.yaml] [--background BG.png]\n"
       "                       [--seed S] [--no-noise] [--force-n F] [--conformity on|off]\n"
       "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
+      "                       [--contact-stats]\n"
       "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
       "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png",
       "Renders one DIGIT frame of a mesh pressed into the gel, with or without texture, or a\n"
@@ -86,6 +88,9 @@ norm2tex::cli::Program makeProgram() {
       ("depth-out", po::value<std::string>()->value_name("D.tiff"),
        "Gel deformation, metres, 32-bit float TIFF.")                                 //
       ("mask-out", po::value<std::string>()->value_name("M.png"), "Contact, mono8.")  //
+      ("contact-stats", po::bool_switch(),
+       "Also print |frame - background| over the contact (B, G, R pooled): its mean and 95th "
+       "percentile, grey levels, as real presses are measured (docs/calibration.md).")  //
       ("sheet", po::bool_switch(),
        "A contact sheet (grid PNG): one column per press depth, one row without texture, then "
        "one row per normal map.")  //
@@ -217,6 +222,9 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   if (!sheet && valueOr<std::string>(args, "normal-map", "").find(',') != std::string::npos) {
     throw norm2tex::cli::UsageError("several --normal-map files only with --sheet");
   }
+  if (sheet && args["contact-stats"].as<bool>()) {
+    throw norm2tex::cli::UsageError("--contact-stats measures one frame, not a --sheet");
+  }
   if (args.count("material") + args.count("normal-map") + args.count("atlas") > 1) {
     throw norm2tex::cli::UsageError("give one of --material, --normal-map and --atlas");
   }
@@ -303,6 +311,13 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   }
   std::printf("%s: %d contact pixels, %s, %d triangles rasterized, %.2f ms\n", output.c_str(),
               cv::countNonZero(frame.contact_mask), texture, frame.raster.triangles_rasterized, ms);
+  if (args["contact-stats"].as<bool>()) {
+    const norm2tex::ContactDifference d = norm2tex::measureContactDifference(
+        frame.image, renderer.shader().background(), frame.contact_mask);
+    std::printf("contact |frame - background|: mean %.1f, 95th percentile %.0f grey levels "
+                "(B, G, R over %d pixels)\n",
+                d.mean_abs, d.p95_abs, d.pixels);
+  }
   if (frame.conformity) {
     const norm2tex::ConformityStats& c = *frame.conformity;
     std::printf("conformity: %.3g N over %.3g mm^2 (mean %.4g MPa); depth followed per band",

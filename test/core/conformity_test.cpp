@@ -294,8 +294,8 @@ TEST(ConformityRender, FlatFaceShowsMoreTextureTheHarderItIsPressed) {
 
 TEST(ConformityRender, BallShowsMoreTextureAtItsCentreThanNearItsRim) {
   // A 10 mm ball pressed 0.5 mm, its force from the gel law (4.7 N): the Winkler pressure is
-  // highest at the centre and falls to 0 at the rim. The same press with conformity off is the
-  // control: whatever geometry and shading do to the texture at the rim, they do to both.
+  // highest at the centre and falls to 0 at the rim, so the centre shows more of the texture,
+  // the more so the stiffer the gel.
   const double radius_mm = 5.0, press_mm = 0.5;
   const auto ball =
       std::make_shared<const TexturedMesh>(makeUvSphere(radius_mm * 1e-3, 96, 192));
@@ -319,21 +319,20 @@ TEST(ConformityRender, BallShowsMoreTextureAtItsCentreThanNearItsRim) {
     }
     return textureRms(image, smooth.image, inner) / textureRms(image, smooth.image, rim);
   };
-  const double ratio_off = centreToRimRatio(makeDigitSensorModel());
-  // The default E* (0.1 MPa): the ball's pressure (0.32 MPa mean) exceeds every band's p*
-  // over most of the contact, so only the outermost rim loses texture.
+  // The shipped gel (E* 0.1 MPa, its coating): the ball's pressure (0.32 MPa mean) is highest at
+  // the centre, where the gel follows the most of the relief.
   const double ratio_default = centreToRimRatio(conformingSensor());
-  EXPECT_GT(ratio_default, 1.0) << "centre / rim texture RMS with conformity";
-  EXPECT_GE(ratio_default, 0.99 * ratio_off);
+  EXPECT_GT(ratio_default, 1.5) << "centre / rim texture RMS with conformity";
   // A stiffer gel (E* 1 MPa), whose p* the ball's pressure spans from centre to rim: the
-  // conformity itself adds to the centre's lead. (In the image the rim band also holds the
-  // gel model's core edge, at 0.77 of the radius for a ball, which flips with any texture at
-  // all; the model-level test above shows the effect without it.)
+  // conformity itself adds to the centre's lead. (The fixed-depth overlay is no control here:
+  // in the image the rim band also holds the gel model's core edge, at 0.77 of the radius for a
+  // ball, which flips with any texture at all, so its ratio says little; the model-level test
+  // above shows the effect without it.)
   SensorModel stiff = conformingSensor();
   stiff.conformity.contact_modulus_mpa = 1.0;
   const double ratio_stiff = centreToRimRatio(stiff);
-  EXPECT_GT(ratio_stiff, 1.05 * ratio_off) << "with conformity (E* 1 MPa) " << ratio_stiff
-                                           << ", without " << ratio_off;
+  EXPECT_GT(ratio_stiff, 1.2 * ratio_default) << "E* 1 MPa " << ratio_stiff << ", 0.1 MPa "
+                                              << ratio_default;
 }
 
 TEST(ConformityRender, OffIsTheFixedDepthOverlayBitForBit) {
@@ -373,7 +372,7 @@ TEST(ConformityRender, TheCoatingLeavesAnUntexturedPressAsItWas) {
   // The coating only changes how much texture the gel follows: a ball without texture (what
   // the calibration fits) renders bit for bit as without a coating, at any force.
   SensorModel coated = makeDigitSensorModel();
-  ASSERT_DOUBLE_EQ(coated.conformity.coating_length_mm, 0.20) << "the shipped coating";
+  ASSERT_DOUBLE_EQ(coated.conformity.coating_length_mm, 0.23) << "the shipped coating";
   SensorModel bare = coated;
   bare.conformity.coating_length_mm = 0.0;
   const auto ball = std::make_shared<const TexturedMesh>(makeUvSphere(3e-3, 96, 192));

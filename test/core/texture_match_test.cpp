@@ -61,7 +61,7 @@ const TextureSample& fabric() {
   return sample;
 }
 
-// A coarse weave (threads 2 mm apart, 0.2 mm high): relief long enough for the shipped gel's
+// A coarse weave (threads 2 mm apart, 0.1 mm high): relief long enough for the shipped gel's
 // coating to let through, so its depth shows at every force. The shipped weave's 0.5 mm threads
 // are held back by the coating to a texture below the sensor's noise on a flat face.
 const TextureSample& coarseFabric() {
@@ -71,8 +71,8 @@ const TextureSample& coarseFabric() {
     config.size = 512;
     config.mm_per_texel = 0.1;
     config.parameters["thread_spacing_mm"] = 2.0;
-    config.parameters["thread_height_mm"] = 0.2;
-    config.beta_mm = 0.2;
+    config.parameters["thread_height_mm"] = 0.1;
+    config.beta_mm = 0.1;
     return makeMaterialSample(config, 0);
   }();
   return sample;

@@ -23,7 +23,8 @@ def test_a_scripted_hold_reaches_its_opening_and_images_show_the_press():
     again, _ = hold_images.hold_images("wood", "norm2tex", [0, 1], episodes=3, seed=5)
     np.testing.assert_array_equal(left, again)
     flat, _ = hold_images.hold_images("wood", "textureless", [0, 1], episodes=3, seed=5)
-    contact = np.abs(flat).max(axis=-1) * 255 > 10
+    # Where the textureless press shows at all (its shading's skirt reaches past the contact).
+    contact = np.abs(flat).max(axis=-1) * 255 > 2
     texture = np.abs(left - flat).max(axis=-1)[contact] * 255
     assert contact.sum() > 1000 and texture.mean() > 1.0, (contact.sum(), texture.mean())
     assert (np.abs(left - flat).max(axis=-1)[~contact] * 255).mean() < texture.mean() / 3

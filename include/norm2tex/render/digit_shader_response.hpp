@@ -55,8 +55,10 @@ std::string shadingFeatureNames();
 
 /// The response fitted on the MIT calibration set of one real DIGIT (digit_calibration_s09,
 /// session sphere2: 49 presses of a 6 mm ball, at its measured 0.0532 mm/px, rim-shadow sigma
-/// 0.6 mm, norm2tex_calibrate); rows B, G, R.
+/// 0.6 mm, slope saturation 0.3 (kDefaultSlopeSaturation), norm2tex_calibrate); rows B, G, R.
 std::array<std::array<double, kShadingFeatureCount>, 3> defaultShadingResponse();
+/// The slope saturation defaultShadingResponse() was fitted with (and makeDigitSensorModel's).
+constexpr double kDefaultSlopeSaturation = 0.3;
 
 /// How far (pixels) beyond the last deformed pixel the features can be non-zero.
 int shadingReachPixels(double mm_per_pixel, double shadow_sigma_mm);

@@ -38,7 +38,9 @@ struct ShadingOptions {
   /// The slope s at which the slope features saturate: each takes g / sqrt(1 + |g|^2 / s^2)
   /// for the gel's slope g (mm/mm), so steep flanks of a deep press answer less than linearly;
   /// s = 1 makes them the gel normal's tangential components (a Lambertian surface's light is
-  /// linear in the normal, not in the slope). 0: the slopes themselves (no saturation).
+  /// linear in the normal, not in the slope). 0: the slopes themselves (no saturation). The
+  /// built-in DIGIT's is 0.3 (kDefaultSlopeSaturation, with its response); a yaml that gives a
+  /// response without it means 0.
   double slope_saturation = 0.0;
 };
 
@@ -83,8 +85,8 @@ struct ConformityOptions {
   /// (E* k / 2 + D k^4) w of pressure to bend into relief of wavenumber k and amplitude w, so it
   /// follows relief of wavelength lambda only at (1 + (2 pi l / lambda)^3) times Johnson's p*:
   /// short wavelengths are filtered, coarse relief is not. 0: no coating (Johnson's half-space).
-  /// 0.20 mm: fitted to a real DIGIT pressing 0.6 mm ridges at 5-12 N (docs/sensor.md).
-  double coating_length_mm = 0.20;
+  /// 0.23 mm: fitted to a real DIGIT pressing 0.6 mm ridges at 5-12 N (docs/sensor.md).
+  double coating_length_mm = 0.23;
 };
 
 /// Everything about one DIGIT that the renderer needs, loaded from config/digit.yaml.

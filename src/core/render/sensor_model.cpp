@@ -99,6 +99,9 @@ void readShading(const YAML::Node& node, ShadingOptions& shading) {
   read(node, "gain", shading.gain);
   read(node, "shadow_sigma_mm", shading.shadow_sigma_mm);
   read(node, "slope_saturation", shading.slope_saturation);
+  // A response belongs with the saturation it was fitted with: one given without it was fitted
+  // on the slopes themselves (every calibrated yaml written before the option existed).
+  if (node["response"] && !node["slope_saturation"]) shading.slope_saturation = 0.0;
   if (const YAML::Node response = node["response"]) {
     rejectUnknownKeys(response, "shading.response");
     for (int k = 0; k < 3; ++k) {
@@ -139,6 +142,7 @@ SensorModel makeDigitSensorModel(bool vga) {
   SensorModel model;
   model.leds = defaultLeds();
   model.shading.response_bgr = defaultShadingResponse();
+  model.shading.slope_saturation = kDefaultSlopeSaturation;
   if (vga) {
     model.rows = 640;
     model.cols = 480;
