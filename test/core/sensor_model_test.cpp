@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/render/digit_shader_response.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "test_helpers.hpp"
 
@@ -25,6 +26,8 @@ TEST(SensorModel, ShippedConfigLoadsAndMatchesTheDefaults) {
   EXPECT_EQ(shipped.gel.final_sigma_mm, defaults.gel.final_sigma_mm);
   EXPECT_EQ(shipped.shading.kind, ShadingKind::kCalibrated);
   EXPECT_EQ(shipped.shading.shadow_sigma_mm, defaults.shading.shadow_sigma_mm);
+  EXPECT_EQ(shipped.shading.slope_saturation, defaults.shading.slope_saturation);
+  EXPECT_EQ(shipped.conformity.coating_length_mm, defaults.conformity.coating_length_mm);
   for (int k = 0; k < 3; ++k) {
     for (int j = 0; j < kShadingFeatureCount; ++j) {
       EXPECT_NEAR(shipped.shading.response_bgr[k][j], defaults.shading.response_bgr[k][j], 1e-9)
@@ -74,6 +77,29 @@ TEST(SensorModel, SavedModelLoadsBackTheSame) {
   EXPECT_DOUBLE_EQ(loaded.gel_pad_width_mm, 18.35);
   EXPECT_EQ(loaded.leds[1].position_mm, m.leds[1].position_mm);
   EXPECT_EQ(loaded.background_image, dir.path("bg.png")) << "relative to the yaml";
+}
+
+// A response belongs with the slope saturation it was fitted with: a yaml that gives one without
+// the other (every calibrated yaml written before the option) was fitted on the slopes
+// themselves; one that gives neither keeps the built-in pair; a saved model keeps its own.
+TEST(SensorModel, AResponseWithoutItsSlopeSaturationWasFittedWithoutOne) {
+  test::ScratchDirectory dir;
+  std::ofstream(dir.path("old.yaml")) << "shading:\n  response:\n    blue: [" << [] {
+    std::string values;
+    for (int j = 0; j < kShadingFeatureCount; ++j) values += (j ? ", " : "") + std::to_string(j);
+    return values;
+  }() << "]\n";
+  EXPECT_EQ(loadSensorModel(dir.path("old.yaml")).shading.slope_saturation, 0.0);
+  std::ofstream(dir.path("neither.yaml")) << "shading:\n  gain: 1.0\n";
+  EXPECT_EQ(loadSensorModel(dir.path("neither.yaml")).shading.slope_saturation,
+            kDefaultSlopeSaturation);
+  SensorModel m = makeDigitSensorModel();
+  m.shading.slope_saturation = 0.7;
+  saveSensorModel(m, dir.path("saved.yaml"));
+  EXPECT_EQ(loadSensorModel(dir.path("saved.yaml")).shading.slope_saturation, 0.7);
+  std::ofstream(dir.path("bad.yaml")) << "shading:\n  slope_saturation: 0.01\n";
+  test::expectError([&] { loadSensorModel(dir.path("bad.yaml")); },
+                    {"shading.slope_saturation", "0 (none) or [0.05, 20]"});
 }
 
 TEST(SensorModel, UnknownKeysAreErrorsNamingTheKey) {

@@ -59,6 +59,25 @@ TEST_F(RenderCli, WritesImageDepthAndMask) {
   EXPECT_NEAR(m.m10 / m.m00, 119.5 + 2.0 / mm_per_pixel, 1.5) << "x = +2 mm is right of centre";
 }
 
+TEST_F(RenderCli, ContactStatsMeasureThePressAgainstTheBackground) {
+  // The figure real presses are compared with: |frame - background| over the contact. The
+  // synthetic background without noise: a press away from the frame's contact changes nothing.
+  const CliRun run = render(std::string(kBall) + " --no-noise --contact-stats -o " +
+                            path("frame.png") + " --mask-out " + path("mask.png"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string key = "contact |frame - background|: mean ";
+  const size_t at = run.output.find(key);
+  ASSERT_NE(at, std::string::npos) << run.output;
+  const double mean = std::stod(run.output.substr(at + key.size()));
+  EXPECT_GT(mean, 5.0) << run.output;
+  EXPECT_LT(mean, 60.0) << run.output;
+  EXPECT_NE(run.output.find("95th percentile"), std::string::npos) << run.output;
+  const CliRun sheet = render(std::string(kBall) + " --sheet --contact-stats -o " +
+                              path("sheet.png"));
+  EXPECT_EQ(sheet.exit_code, 2) << sheet.output;
+  EXPECT_NE(sheet.output.find("--contact-stats"), std::string::npos) << sheet.output;
+}
+
 TEST_F(RenderCli, SheetHasOneRowPerTextureAndOneColumnPerPress) {
   const CliRun run =
       render(std::string("--sheet ") + kBall + " --presses 0.5,1 --normal-map " +
