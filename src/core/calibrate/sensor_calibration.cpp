@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "norm2tex/calibrate/background_noise.hpp"
+#include "norm2tex/calibrate/ball_press.hpp"
 #include "norm2tex/calibrate/press_refinement.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader.hpp"
@@ -66,6 +67,25 @@ void removeDrift(PressObservation& press) {
   press.diff -= cv::Scalar(offset[0], offset[1], offset[2]);
 }
 
+// A press's render at the fitted model against its real frame (the frame as captured).
+PressFrameComparison compareFrames(const PressObservation& press, const cv::Mat3b& real_frame,
+                                   const cv::Mat3b& background, const cv::Mat3f& simulated_diff,
+                                   const SensorModel& model, const PressGeometry& geometry,
+                                   double ball_radius_mm) {
+  PressFrameComparison comparison;
+  comparison.name = press.name;
+  comparison.circle = press.circle;
+  comparison.contact_radius_px = press.circle.radius_px * geometry.radius_factor;
+  comparison.depth_mm =
+      ballPressDepthMm(comparison.contact_radius_px * model.mm_per_pixel, ball_radius_mm);
+  const cv::Mat1b contact =
+      contactDiscMask(real_frame.size(), press.circle.centre_px, comparison.contact_radius_px);
+  comparison.similarity =
+      compareImages(renderedPressFrame(background, simulated_diff), real_frame, contact);
+  comparison.bare_background = compareImages(background, real_frame, contact);
+  return comparison;
+}
+
 }  // namespace
 
 CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
@@ -99,6 +119,7 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
 
   // Contact circles and drift-corrected differences.
   std::vector<PressObservation> training, held_out;
+  std::vector<int> training_index, held_out_index;  // each press's place in the input
   std::set<std::string> labelled;  // presses whose circle the user gave: never refined
   const int n = static_cast<int>(input.presses.size());
   const int held_out_count =
@@ -116,6 +137,7 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
     // count floor((i + 1) k / n) steps up.
     const bool hold = (i + 1) * held_out_count / n > i * held_out_count / n;
     (hold ? held_out : training).push_back(std::move(press));
+    (hold ? held_out_index : training_index).push_back(i);
   }
 
   const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
@@ -157,13 +179,33 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   }());
   result.model.background_image.clear();
 
-  // Held-out presses, rendered by the shader itself at the fitted geometry.
+  // Every press rendered by the shader itself at the fitted geometry: the held-out ones judge
+  // the fit; the fitted ones' frames are compared too (one render each, cheap beside the fit).
   const DigitShader shader(result.model, result.background, BackgroundSource::kCaptured);
-  for (PressObservation& press : held_out) {
-    const cv::Mat1f gel =
-        simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm);
-    result.held_out_simulated.push_back(shader.shadingDifference(gel));
-    result.held_out_radii_px.push_back(press.circle.radius_px * result.fit.geometry.radius_factor);
+  const auto simulate = [&](const PressObservation& press) {
+    return shader.shadingDifference(
+        simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm));
+  };
+  const auto compare = [&](const PressObservation& press, int index, const cv::Mat3f& simulated,
+                           bool is_held_out) {
+    PressFrameComparison comparison =
+        compareFrames(press, input.presses[index].image, result.background, simulated,
+                      result.model, result.fit.geometry, ball_radius_mm);
+    comparison.index = index;
+    comparison.held_out = is_held_out;
+    comparison.labelled = labelled.count(press.name) > 0;
+    return comparison;
+  };
+  for (size_t i = 0; i < held_out.size(); ++i) {
+    result.held_out_simulated.push_back(simulate(held_out[i]));
+    result.held_out_radii_px.push_back(held_out[i].circle.radius_px *
+                                       result.fit.geometry.radius_factor);
+    result.held_out_frames.push_back(
+        compare(held_out[i], held_out_index[i], result.held_out_simulated.back(), true));
+  }
+  for (size_t i = 0; i < training.size(); ++i) {
+    result.training_frames.push_back(
+        compare(training[i], training_index[i], simulate(training[i]), false));
   }
   result.held_out_presses = std::move(held_out);
   result.held_out =
