@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -26,40 +25,23 @@ void checkPair(const cv::Mat& a, const cv::Mat& b, const char* what) {
     throw Error(std::string(what) + ": images must be 8-bit (grey levels 0-255); got " +
                 describe(a) + " and " + describe(b));
   }
+  if (a.channels() > 4) {
+    throw Error(std::string(what) + ": images of 1 to 4 channels only; got " + describe(a));
+  }
   if (a.size() != b.size() || a.channels() != b.channels()) {
     throw Error(std::string(what) + ": images differ in size or channels: " + describe(a) +
                 " and " + describe(b));
   }
 }
 
-// The local mean of `x` under the SSIM window. scipy.ndimage.gaussian_filter(sigma=1.5,
-// truncate=3.5) uses the 11-tap kernel exp(-x^2 / 2 sigma^2), normalised: the kernel OpenCV
-// builds for ksize 11 and sigma 1.5 in double precision.
-cv::Mat1d windowMean(const cv::Mat1d& x) {
-  cv::Mat1d mean;
+// The local mean of `x` (every channel) under the SSIM window. scipy.ndimage.gaussian_filter(
+// sigma=1.5, truncate=3.5) uses the 11-tap kernel exp(-x^2 / 2 sigma^2), normalised: the kernel
+// OpenCV builds for ksize 11 and sigma 1.5 in double precision.
+cv::Mat windowMean(const cv::Mat& x) {
+  cv::Mat mean;
   cv::GaussianBlur(x, mean, cv::Size(kSsimWindow, kSsimWindow), kSsimSigma, kSsimSigma,
                    cv::BORDER_REFLECT);
   return mean;
-}
-
-// SSIM map of one channel (Wang et al. 2004, eq. 13), with population variances.
-cv::Mat1d channelSsimMap(const cv::Mat1d& x, const cv::Mat1d& y) {
-  const double c1 = (kSsimK1 * kSsimRange) * (kSsimK1 * kSsimRange);
-  const double c2 = (kSsimK2 * kSsimRange) * (kSsimK2 * kSsimRange);
-  const cv::Mat1d ux = windowMean(x), uy = windowMean(y);
-  const cv::Mat1d uxx = windowMean(x.mul(x)), uyy = windowMean(y.mul(y));
-  const cv::Mat1d uxy = windowMean(x.mul(y));
-  cv::Mat1d map(x.size());
-  for (int r = 0; r < x.rows; ++r) {
-    for (int c = 0; c < x.cols; ++c) {
-      const double mx = ux(r, c), my = uy(r, c);
-      const double vx = uxx(r, c) - mx * mx, vy = uyy(r, c) - my * my;
-      const double vxy = uxy(r, c) - mx * my;
-      map(r, c) = (2.0 * mx * my + c1) * (2.0 * vxy + c2) /
-                  ((mx * mx + my * my + c1) * (vx + vy + c2));
-    }
-  }
-  return map;
 }
 
 double meanSquaredDifference(const cv::Mat& a, const cv::Mat& b) {
@@ -78,17 +60,34 @@ cv::Mat1d structuralSimilarityMap(const cv::Mat& a, const cv::Mat& b) {
     throw Error("SSIM: images of " + describe(a) + " are smaller than the " +
                 std::to_string(kSsimWindow) + " x " + std::to_string(kSsimWindow) + " window");
   }
-  std::vector<cv::Mat> channels_a, channels_b;
-  cv::split(a, channels_a);
-  cv::split(b, channels_b);
-  cv::Mat1d sum(a.size(), 0.0);
-  for (size_t k = 0; k < channels_a.size(); ++k) {
-    cv::Mat1d x, y;
-    channels_a[k].convertTo(x, CV_64F);
-    channels_b[k].convertTo(y, CV_64F);
-    sum += channelSsimMap(x, y);
+  // All channels filtered at once (five blurs, not five per channel): the calibration compares
+  // two frames per press.
+  const int channels = a.channels();
+  cv::Mat x, y;
+  a.convertTo(x, CV_64F);
+  b.convertTo(y, CV_64F);
+  const cv::Mat ux = windowMean(x), uy = windowMean(y);
+  const cv::Mat uxx = windowMean(x.mul(x)), uyy = windowMean(y.mul(y));
+  const cv::Mat uxy = windowMean(x.mul(y));
+  const double c1 = (kSsimK1 * kSsimRange) * (kSsimK1 * kSsimRange);
+  const double c2 = (kSsimK2 * kSsimRange) * (kSsimK2 * kSsimRange);
+  cv::Mat1d map(a.size());
+  for (int r = 0; r < a.rows; ++r) {
+    const double *mx = ux.ptr<double>(r), *my = uy.ptr<double>(r);
+    const double *mxx = uxx.ptr<double>(r), *myy = uyy.ptr<double>(r), *mxy = uxy.ptr<double>(r);
+    for (int c = 0; c < a.cols; ++c) {
+      double sum = 0.0;
+      for (int k = c * channels; k < (c + 1) * channels; ++k) {
+        // Wang et al. 2004, eq. 13, with population variances, for one channel.
+        const double vx = mxx[k] - mx[k] * mx[k], vy = myy[k] - my[k] * my[k];
+        const double vxy = mxy[k] - mx[k] * my[k];
+        sum += (2.0 * mx[k] * my[k] + c1) * (2.0 * vxy + c2) /
+               ((mx[k] * mx[k] + my[k] * my[k] + c1) * (vx + vy + c2));
+      }
+      map(r, c) = sum / channels;
+    }
   }
-  return sum / static_cast<double>(channels_a.size());
+  return map;
 }
 
 double meanSsimOver(const cv::Mat1d& ssim_map, const cv::Mat& mask) {

@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <string>
+
+#include <opencv2/core/utility.hpp>
 
 #include "norm2tex/calibrate/background_noise.hpp"
 #include "norm2tex/calibrate/ball_press.hpp"
@@ -181,31 +185,42 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
 
   // Every press rendered by the shader itself at the fitted geometry: the held-out ones judge
   // the fit; the fitted ones' frames are compared too (one render each, cheap beside the fit).
+  // Presses on all cores, each into its own slot (DigitShader keeps per-thread scratch).
   const DigitShader shader(result.model, result.background, BackgroundSource::kCaptured);
-  const auto simulate = [&](const PressObservation& press) {
-    return shader.shadingDifference(
-        simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm));
-  };
-  const auto compare = [&](const PressObservation& press, int index, const cv::Mat3f& simulated,
-                           bool is_held_out) {
-    PressFrameComparison comparison =
-        compareFrames(press, input.presses[index].image, result.background, simulated,
-                      result.model, result.fit.geometry, ball_radius_mm);
-    comparison.index = index;
-    comparison.held_out = is_held_out;
-    comparison.labelled = labelled.count(press.name) > 0;
-    return comparison;
-  };
-  for (size_t i = 0; i < held_out.size(); ++i) {
-    result.held_out_simulated.push_back(simulate(held_out[i]));
-    result.held_out_radii_px.push_back(held_out[i].circle.radius_px *
-                                       result.fit.geometry.radius_factor);
-    result.held_out_frames.push_back(
-        compare(held_out[i], held_out_index[i], result.held_out_simulated.back(), true));
-  }
-  for (size_t i = 0; i < training.size(); ++i) {
-    result.training_frames.push_back(
-        compare(training[i], training_index[i], simulate(training[i]), false));
+  const int held_out_jobs = static_cast<int>(held_out.size());
+  const int press_count = held_out_jobs + static_cast<int>(training.size());
+  result.held_out_simulated.resize(held_out.size());
+  result.held_out_frames.resize(held_out.size());
+  result.training_frames.resize(training.size());
+  std::mutex error_mutex;
+  std::string error;
+  cv::parallel_for_(cv::Range(0, press_count), [&](const cv::Range& range) {
+    for (int job = range.start; job < range.end; ++job) {
+      const bool is_held_out = job < held_out_jobs;
+      const int i = is_held_out ? job : job - held_out_jobs;
+      const PressObservation& press = is_held_out ? held_out[i] : training[i];
+      const int index = is_held_out ? held_out_index[i] : training_index[i];
+      try {
+        const cv::Mat3f simulated = shader.shadingDifference(
+            simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm));
+        PressFrameComparison comparison =
+            compareFrames(press, input.presses[index].image, result.background, simulated,
+                          result.model, result.fit.geometry, ball_radius_mm);
+        comparison.index = index;
+        comparison.held_out = is_held_out;
+        comparison.labelled = labelled.count(press.name) > 0;
+        if (is_held_out) result.held_out_simulated[i] = simulated;
+        (is_held_out ? result.held_out_frames[i] : result.training_frames[i]) =
+            std::move(comparison);
+      } catch (const std::exception& e) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (error.empty()) error = e.what();
+      }
+    }
+  });
+  if (!error.empty()) throw Error(error);
+  for (const PressObservation& press : held_out) {
+    result.held_out_radii_px.push_back(press.circle.radius_px * result.fit.geometry.radius_factor);
   }
   result.held_out_presses = std::move(held_out);
   result.held_out =
