@@ -36,6 +36,7 @@ _CORE_NAMES = (
     "RenderedFrame",
     "read_image",
     "calibrate_sensor",
+    "compare_images",
     "measure_ridge_contrast",
     "TactileRenderer",
     "GripperOptions",

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "norm2tex/calibrate/image_metrics.hpp"
 #include "norm2tex/calibrate/ridge_contrast.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
 #include <opencv2/imgcodecs.hpp>
@@ -27,6 +28,43 @@
 namespace norm2tex {
 namespace python {
 namespace {
+
+// An 8-bit image from numpy: (rows, cols) grey or (rows, cols, 3) bgr.
+cv::Mat imageFromNumpy(const py::handle& handle, const std::string& what) {
+  const py::array array = py::array::ensure(handle);
+  const bool grey = array && array.ndim() == 2;
+  return fromNumpy(handle, grey ? CV_8UC1 : CV_8UC3, what);
+}
+
+// One press's frame comparison, keyed as in norm2tex_calibrate's --json report.
+py::dict pressFrameDict(const PressFrameComparison& press) {
+  py::dict out;
+  out["image"] = press.name;
+  out["index"] = press.index;
+  out["held_out"] = press.held_out;
+  out["labelled"] = press.labelled;
+  out["centre_px"] = py::make_tuple(press.circle.centre_px.x, press.circle.centre_px.y);
+  out["radius_px"] = press.circle.radius_px;
+  out["contact_radius_px"] = press.contact_radius_px;
+  out["depth_mm"] = press.depth_mm;
+  out["ssim"] = press.similarity.ssim;
+  out["contact_ssim"] = press.similarity.ssim_in_mask;
+  out["psnr_db"] = press.similarity.psnr_db;
+  out["mean_abs_diff"] = press.similarity.mean_abs_diff;
+  py::dict bare;
+  bare["ssim"] = press.bare_background.ssim;
+  bare["contact_ssim"] = press.bare_background.ssim_in_mask;
+  bare["psnr_db"] = press.bare_background.psnr_db;
+  bare["mean_abs_diff"] = press.bare_background.mean_abs_diff;
+  out["bare_background"] = bare;
+  return out;
+}
+
+py::list pressFrameList(const std::vector<PressFrameComparison>& presses) {
+  py::list out;
+  for (const PressFrameComparison& press : presses) out.append(pressFrameDict(press));
+  return out;
+}
 
 using Release = py::call_guard<py::gil_scoped_release>;
 
@@ -401,6 +439,13 @@ void bindRender(py::module& m) {
         out["side_error_deg"] = py::make_tuple(result.held_out.side_error_deg[0],
                                                result.held_out.side_error_deg[1],
                                                result.held_out.side_error_deg[2]);
+        out["held_out_frames"] = pressFrameList(result.held_out_frames);
+        out["training_frames"] = pressFrameList(result.training_frames);
+        const ImageSimilarity medians = medianSimilarity(result.held_out_frames);
+        out["median_ssim"] = medians.ssim;
+        out["median_contact_ssim"] = medians.ssim_in_mask;
+        out["median_psnr_db"] = medians.psnr_db;
+        out["median_mean_abs_diff"] = medians.mean_abs_diff;
         return out;
       },
       py::arg("base"), py::arg("backgrounds"), py::arg("presses"), py::arg("ball_diameter_mm"),
@@ -410,7 +455,38 @@ void bindRender(py::module& m) {
       "the scale (mm per pixel; None: fitted). Returns a dict: model (SensorModel; its "
       "background_image unset), background (the mean no-contact frame), training_presses, "
       "held_out_presses and how well the model reproduces those: variance_explained, "
-      "real_contact_mean / sim_contact_mean (grey levels), side_error_deg (B, G, R).");
+      "real_contact_mean / sim_contact_mean (grey levels), side_error_deg (B, G, R); each press's "
+      "render against its real frame in held_out_frames and training_frames (dicts keyed as "
+      "norm2tex_calibrate's --json presses: ssim, contact_ssim, psnr_db, mean_abs_diff, circle, "
+      "depth_mm, bare_background: the background alone against the frame, ...), and the "
+      "held-out medians median_ssim, median_contact_ssim, median_psnr_db, "
+      "median_mean_abs_diff.");
+
+  m.def(
+      "compare_images",
+      [](const py::handle& a, const py::handle& b, const py::handle& mask) {
+        const cv::Mat image_a = imageFromNumpy(a, "a"), image_b = imageFromNumpy(b, "b");
+        const cv::Mat mask_image = mask.is_none() ? cv::Mat() : fromNumpy(mask, CV_8UC1, "mask");
+        ImageSimilarity s;
+        {
+          py::gil_scoped_release release;
+          s = compareImages(image_a, image_b, mask_image);
+        }
+        py::dict out;
+        out["ssim"] = s.ssim;
+        out["ssim_in_mask"] = s.ssim_in_mask;
+        out["psnr_db"] = s.psnr_db;
+        out["mean_abs_diff"] = s.mean_abs_diff;
+        return out;
+      },
+      py::arg("a"), py::arg("b"), py::arg("mask") = py::none(),
+      "How alike two uint8 images are ((rows, cols) grey or (rows, cols, 3) bgr, same shape): "
+      "dict ssim (Wang et al. 2004, Gaussian window sigma 1.5, per-channel mean; equals "
+      "skimage.metrics.structural_similarity(a, b, channel_axis=2, gaussian_weights=True, "
+      "sigma=1.5, use_sample_covariance=False, data_range=255)), ssim_in_mask (the SSIM map's "
+      "mean where mask (rows, cols) uint8 is non-zero, the 5 px border left out as in ssim; "
+      "None: everywhere), psnr_db (peak 255; inf for identical images), mean_abs_diff (grey "
+      "levels). Raises norm2tex.Error for images of different shape or smaller than 11 x 11.");
 
   py::class_<RenderedFrame>(m, "RenderedFrame", "One DIGIT frame (copies, yours to keep).")
       .def_readonly("image", &RenderedFrame::image, "(rows, cols, 3) uint8, bgr8")

@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli_arguments.hpp"
+#include "norm2tex/calibrate/calibration_json.hpp"
 #include "norm2tex/calibrate/calibration_report.hpp"
 #include "norm2tex/calibrate/press_labels.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
@@ -35,7 +36,7 @@ norm2tex::cli::Program makeProgram() {
       "norm2tex_calibrate --background BG.png [BG2.png ...] --presses P1.png P2.png ...\n"
       "                          --ball-diameter-mm D [--mm-per-pixel S] [--labels labels.csv]\n"
       "                          [--size WxH] [--sensor base.yaml] [--holdout F]\n"
-      "                          -o SENSOR.yaml [--report REPORT.png]",
+      "                          -o SENSOR.yaml [--report REPORT.png] [--json REPORT.json]",
       "Fits a sensor yaml to your DIGIT from no-contact frames and a few ball presses: the scale\n"
       "(unless --mm-per-pixel), the calibrated shading with its rim shadow, and the noise of\n"
       "your no-contact frames, which become the sensor's background (written beside the yaml as\n"
@@ -67,7 +68,10 @@ norm2tex::cli::Program makeProgram() {
       ("output,o", po::value<std::string>()->value_name("SENSOR.yaml"),
        "The fitted sensor yaml.")  //
       ("report", po::value<std::string>()->value_name("REPORT.png"),
-       "A side-by-side image of held-out presses: real | render | difference.");
+       "A side-by-side image of held-out presses: real | render | difference.")  //
+      ("json", po::value<std::string>()->value_name("REPORT.json"),
+       "A machine-readable report: every press's circle, depth and render-vs-real SSIM (frame and "
+       "contact), PSNR and mean |diff|, their medians and the variance explained.");
   return program;
 }
 
@@ -162,6 +166,8 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   if (!args.count("ball-diameter-mm")) throw UsageError("missing --ball-diameter-mm");
   const std::string output = valueOr<std::string>(args, "output", "");
   if (output.empty()) throw UsageError("missing -o SENSOR.yaml");
+  const std::string json_path = valueOr<std::string>(args, "json", "");
+  if (args.count("json")) norm2tex::checkJsonReportPath(json_path);  // before the fit's work
 
   const auto start = std::chrono::steady_clock::now();
   std::optional<cv::Size> size;
@@ -196,6 +202,9 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   norm2tex::saveSensorModel(model, output);
   if (args.count("report")) {
     norm2tex::writeImage(args["report"].as<std::string>(), norm2tex::makeCalibrationReport(result));
+  }
+  if (args.count("json")) {
+    norm2tex::writeCalibrationReportJson(json_path, result, input.ball_diameter_mm);
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

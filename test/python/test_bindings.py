@@ -4,8 +4,10 @@ Needs the devel (or install) space's environment: `import norm2tex` must find th
 module. NORM2TEX_TOOLS_DIR (default: beside the devel space's lib/norm2tex) holds norm2tex_render.
 """
 
+import json
 import math
 import os
+import statistics
 import subprocess
 import tempfile
 
@@ -191,8 +193,10 @@ def test_calibration_equals_the_cli_on_real_presses(sensor, tmp_path):
     presses = [os.path.join(fixtures, "frame_%d.jpg" % i) for i in range(0, 30, 2)]
     background = os.path.join(fixtures, "frame_30.jpg")
     yaml_path = str(tmp_path / "cli.yaml")
+    json_path = str(tmp_path / "cli.json")
     subprocess.run([tool, "--background", background, "--presses"] + presses +
-                   ["--ball-diameter-mm", "6", "--mm-per-pixel", "0.0532", "-o", yaml_path],
+                   ["--ball-diameter-mm", "6", "--mm-per-pixel", "0.0532", "-o", yaml_path,
+                    "--json", json_path],
                    check=True, capture_output=True)
     cli = norm2tex.SensorModel.load(yaml_path)
     fit = norm2tex.calibrate_sensor(
@@ -206,11 +210,70 @@ def test_calibration_equals_the_cli_on_real_presses(sensor, tmp_path):
     assert fit["training_presses"] + fit["held_out_presses"] == 15
     # It reproduces presses it was not fitted on (the package's documented quality: > 0.8).
     assert fit["variance_explained"] > 0.8
+    # The CLI's --json report: strict JSON (no NaN or Infinity), the same fit's figures.
+    with open(json_path) as f:
+        report = json.load(f, parse_constant=lambda name: pytest.fail("JSON has " + name))
+    assert report["held_out"]["variance_explained"] == pytest.approx(fit["variance_explained"])
+    assert [p["image"] for p in report["presses"]] == presses
+    held_out = [p for p in report["presses"] if p["held_out"]]
+    assert len(held_out) == len(fit["held_out_frames"]) == fit["held_out_presses"]
+    for key in ("ssim", "contact_ssim", "psnr_db", "mean_abs_diff"):
+        median = report["held_out"]["median"][key]
+        assert median == statistics.median(p[key] for p in held_out), key
+        assert fit["median_" + key] == pytest.approx(median, rel=1e-6), key
+        assert [f[key] for f in fit["held_out_frames"]] == pytest.approx(
+            [p[key] for p in held_out], rel=1e-6), key
+    # The goal on held-out presses, and the press clearly better than no press in the contact.
+    assert report["held_out"]["median"]["ssim"] >= 0.90
+    assert (report["held_out"]["median"]["contact_ssim"]
+            > report["held_out"]["median_bare_background"]["contact_ssim"] + 0.04)
     with pytest.raises(norm2tex.Error, match="press"):
         norm2tex.calibrate_sensor(norm2tex.SensorModel(), [norm2tex.read_image(background)],
                                   [norm2tex.read_image(presses[0])], ball_diameter_mm=6.0)
     with pytest.raises(norm2tex.Error, match="nothing.jpg"):
         norm2tex.read_image(os.path.join(fixtures, "nothing.jpg"))
+
+
+def test_compare_images_against_closed_forms_and_scikit_image():
+    """norm2tex.compare_images: perfect on itself, the closed form of constant images, exact PSNR
+    of alternating noise, a clear error for images of different shapes."""
+    rng = np.random.default_rng(3)
+    a = rng.integers(0, 256, (40, 30, 3), dtype=np.uint8)
+    same = norm2tex.compare_images(a, a)
+    assert same["ssim"] == pytest.approx(1.0) and same["psnr_db"] == math.inf
+    c1 = (0.01 * 255) ** 2
+    grey = norm2tex.compare_images(np.full((16, 12), 100, np.uint8), np.full((16, 12), 150, np.uint8))
+    assert grey["ssim"] == pytest.approx((2 * 100 * 150 + c1) / (100 ** 2 + 150 ** 2 + c1))
+    assert grey["mean_abs_diff"] == pytest.approx(50.0)
+    noisy = np.full((20, 30, 3), 128, np.uint8)
+    noisy[::2, ::2] += 5
+    noisy[1::2, 1::2] += 5
+    noisy[::2, 1::2] -= 5
+    noisy[1::2, ::2] -= 5
+    flat = np.full_like(noisy, 128)
+    assert norm2tex.compare_images(flat, noisy)["psnr_db"] == pytest.approx(
+        10 * math.log10(255 ** 2 / 25))
+    with pytest.raises(norm2tex.Error, match="differ"):
+        norm2tex.compare_images(a, a[:, :20])
+
+
+def test_compare_images_equals_scikit_image():
+    """Where scikit-image is installed (it is not a dependency): its SSIM and PSNR, exactly."""
+    skimage_metrics = pytest.importorskip("skimage.metrics")
+    rng = np.random.default_rng(4)
+    a = rng.integers(0, 256, (40, 30, 3), dtype=np.uint8)
+    b = np.clip(a.astype(int) + rng.integers(-30, 31, a.shape), 0, 255).astype(np.uint8)
+    mask = np.zeros((40, 30), np.uint8)
+    mask[10:25, 8:20] = 1  # inside the 5 px border that SSIM's mean leaves out
+    measured = norm2tex.compare_images(a, b, mask)
+    expected, full = skimage_metrics.structural_similarity(
+        a, b, channel_axis=2, gaussian_weights=True, sigma=1.5, use_sample_covariance=False,
+        data_range=255, full=True)
+    assert measured["ssim"] == pytest.approx(expected, abs=1e-12)
+    assert measured["ssim_in_mask"] == pytest.approx(full.mean(axis=2)[10:25, 8:20].mean(),
+                                                     abs=1e-12)
+    assert measured["psnr_db"] == pytest.approx(
+        skimage_metrics.peak_signal_noise_ratio(a, b, data_range=255), abs=1e-12)
 
 
 def test_conformity_from_python_follows_the_force(sensor, cube):

@@ -1,7 +1,7 @@
 // Runs the real norm2tex_calibrate executable on presses rendered with a known sensor: the yaml
-// it writes loads and carries the fit, the background and report are written, labels are used,
-// a fitted scale comes with its profile, and bad input is a one-line error (exit 1) or the usage
-// (exit 2).
+// it writes loads and carries the fit, the background and report are written, the --json report
+// holds every press and its medians, labels are used, a fitted scale comes with its profile, and
+// bad input is a one-line error (exit 1) or the usage (exit 2).
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "cli_runner.hpp"
 #include "norm2tex/calibrate/ball_press.hpp"
@@ -87,6 +88,82 @@ TEST_F(CalibrateCli, WritesASensorYamlThatLoadsWithItsBackgroundAndAReport) {
   const cv::Mat report = cv::imread(path("report.png"));
   EXPECT_EQ(report.cols, 3 * 160);
   EXPECT_GT(report.rows, 160);
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// The --json report, read back with yaml-cpp (a reader independent of the package's writer;
+// tests/python's calibration test reads the real presses' report with Python's strict json).
+TEST_F(CalibrateCli, JsonReportHoldsEveryPressAndTheirMedians) {
+  const CliRun run = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                               " --ball-diameter-mm 6 --mm-per-pixel 0.054 --labels " +
+                               path("labels.csv") + " --holdout 0.5 -o " + path("mine.yaml") +
+                               " --json " + path("report.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("frames, median SSIM"), std::string::npos) << run.output;
+  const YAML::Node report = YAML::LoadFile(path("report.json"));
+  EXPECT_DOUBLE_EQ(report["ball_diameter_mm"].as<double>(), 6.0);
+  EXPECT_DOUBLE_EQ(report["mm_per_pixel"].as<double>(), 0.054);
+  const YAML::Node presses = report["presses"];
+  ASSERT_TRUE(presses.IsSequence());
+  ASSERT_EQ(presses.size(), 6u);
+  const char* measures[] = {"ssim", "contact_ssim", "psnr_db", "mean_abs_diff"};
+  std::vector<double> held_out_values[4], fitted_values[4];
+  for (size_t i = 0; i < presses.size(); ++i) {
+    const YAML::Node press = presses[i];
+    // In input order, each labelled: its circle is the label's.
+    EXPECT_EQ(press["image"].as<std::string>(), path("press" + std::to_string(i) + ".png"));
+    EXPECT_TRUE(press["labelled"].as<bool>());
+    const double radius_px = press["radius_px"].as<double>();
+    EXPECT_NEAR(radius_px * 0.054, 1.1 + 0.12 * static_cast<double>(i), 1e-4);
+    for (const char* key : {"centre_x_px", "centre_y_px", "contact_radius_px", "depth_mm"}) {
+      EXPECT_TRUE(press[key].IsScalar()) << key;
+    }
+    const double a = press["contact_radius_px"].as<double>() * 0.054;
+    EXPECT_NEAR(press["depth_mm"].as<double>(), 3.0 - std::sqrt(9.0 - a * a), 1e-9);
+    for (int m = 0; m < 4; ++m) {
+      const double value = press[measures[m]].as<double>();
+      (press["held_out"].as<bool>() ? held_out_values : fitted_values)[m].push_back(value);
+      EXPECT_TRUE(press["bare_background"][measures[m]].IsScalar()) << measures[m];
+    }
+    // Rendered by the very model that made them (noise apart): close to the real frames.
+    EXPECT_GT(press["ssim"].as<double>(), 0.8);
+    EXPECT_GT(press["contact_ssim"].as<double>(), press["bare_background"]["contact_ssim"].as<double>());
+  }
+  ASSERT_EQ(held_out_values[0].size(), 3u);  // --holdout 0.5 of 6
+  EXPECT_EQ(report["held_out"]["presses"].as<int>(), 3);
+  EXPECT_EQ(report["fitted"]["presses"].as<int>(), 3);
+  EXPECT_GT(report["held_out"]["variance_explained"].as<double>(), 0.8);
+  for (int m = 0; m < 4; ++m) {
+    EXPECT_DOUBLE_EQ(report["held_out"]["median"][measures[m]].as<double>(),
+                     median(held_out_values[m]))
+        << measures[m];
+    EXPECT_DOUBLE_EQ(report["fitted"]["median"][measures[m]].as<double>(),
+                     median(fitted_values[m]))
+        << measures[m];
+    EXPECT_TRUE(report["held_out"]["median_bare_background"][measures[m]].IsScalar());
+  }
+}
+
+// A --json that cannot be written is refused before the fit, as a one-line error, and leaves
+// no yaml behind.
+TEST_F(CalibrateCli, AnUnwritableJsonPathIsAOneLineError) {
+  const std::string arguments = "--background " + path("bg.png") + " --presses" + presses_ +
+                                " --ball-diameter-mm 6 --mm-per-pixel 0.054 -o " +
+                                path("unused.yaml") + " --json ";
+  for (const std::string& bad :
+       {path("bg.png") + "/report.json", path("no_such_dir") + "/report.json", dir_.string()}) {
+    const CliRun run = calibrate(arguments + bad);
+    EXPECT_EQ(run.exit_code, 1) << bad << "\n" << run.output;
+    EXPECT_NE(run.output.find("JSON report '" + bad + "' cannot be written"), std::string::npos)
+        << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("unused.yaml")));
 }
 
 // Without --mm-per-pixel the scale is fitted, and since ball presses pin it only weakly the

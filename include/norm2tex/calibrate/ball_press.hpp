@@ -15,4 +15,8 @@ namespace norm2tex {
 cv::Mat1f ballPressIndentation(const SensorModel& model, const PressCircle& contact,
                                double ball_radius_mm);
 
+/// How deep a rigid ball of `ball_radius_mm` presses into a flat gel to make a contact circle of
+/// `contact_radius_mm`: R - sqrt(R^2 - a^2). Throws Error as ballPressIndentation when a >= R.
+double ballPressDepthMm(double contact_radius_mm, double ball_radius_mm);
+
 }  // namespace norm2tex

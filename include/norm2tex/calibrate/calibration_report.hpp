@@ -15,7 +15,8 @@ namespace norm2tex {
 /// render, amplified 2x around grey 128. Above them, the held-out fit figures as text.
 cv::Mat3b makeCalibrationReport(const CalibrationResult& result, int max_presses = 4);
 
-/// The held-out fit figures as lines of text (for the report image and the tool's output).
+/// The fit figures as lines of text (for the report image and the tool's output): the held-out
+/// presses' measures, then the medians of the frame measures of held-out and fitted presses.
 std::vector<std::string> describeFitQuality(const CalibrationResult& result);
 
 /// When the scale was searched: how well each scale of the coarse grid fits, and the range of

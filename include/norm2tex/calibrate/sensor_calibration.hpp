@@ -8,6 +8,7 @@
 
 #include "norm2tex/calibrate/fit_quality.hpp"
 #include "norm2tex/calibrate/press_detection.hpp"
+#include "norm2tex/calibrate/press_frame_comparison.hpp"
 #include "norm2tex/calibrate/shading_fit.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 
@@ -46,6 +47,9 @@ struct CalibrationResult {
   std::vector<cv::Mat3f> held_out_simulated;  ///< the model's shading difference per press
   std::vector<double> held_out_radii_px;      ///< fitted contact radii
   int training_presses = 0;
+  /// Each press's render (background + simulated difference) against its frame as captured, in
+  /// the order of the input: SSIM, SSIM inside the contact, PSNR, mean |diff|.
+  std::vector<PressFrameComparison> held_out_frames, training_frames;
 };
 
 /// Minimum number of presses: 3 to fit, 1 to hold out.
@@ -57,7 +61,8 @@ constexpr int kMinCalibrationPresses = 4;
 /// geometry and shading on the rest (fitShadingAndGeometry), refines every unlabelled press's
 /// circle against that model (refinePressCircle: geometry only, so held-out presses stay
 /// unseen by the shading fit), refits, renders the held-out presses with DigitShader at the
-/// fitted geometry and compares (compareWithReal), and measures the background noise
+/// fitted geometry and compares (compareWithReal), compares every press's rendered frame with
+/// its real one (held_out_frames, training_frames), and measures the background noise
 /// (measureBackgroundNoise). `base` gives the image size and the parts not
 /// fitted (gel smoothing, camera, LEDs). Throws Error naming the frame for frames of another
 /// size or orientation than `base`, presses it cannot find, a ball that cannot make the

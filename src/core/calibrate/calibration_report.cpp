@@ -32,6 +32,15 @@ cv::Mat3b cropTile(const cv::Mat3b& image, cv::Point2d centre, double half) {
   return tile;
 }
 
+// The medians of the frame measures (render vs real frame, PressFrameComparison) of a set.
+std::string describeFrameMedians(const std::vector<PressFrameComparison>& frames,
+                                 ImageSimilarity PressFrameComparison::*measures) {
+  if (frames.empty()) return "frames: none";
+  const ImageSimilarity m = medianSimilarity(frames, measures);
+  return format("frames, median SSIM %.3f (contact %.3f), PSNR %.1f dB, |diff| %.1f", m.ssim,
+                m.ssim_in_mask, m.psnr_db, m.mean_abs_diff);
+}
+
 }  // namespace
 
 std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
@@ -49,6 +58,11 @@ std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
       format("  brightened side B/G/R deg real %.0f %.0f %.0f sim %.0f %.0f %.0f",
              q.real_side_deg[0], q.real_side_deg[1], q.real_side_deg[2], q.sim_side_deg[0],
              q.sim_side_deg[1], q.sim_side_deg[2]),
+      "  " + describeFrameMedians(r.held_out_frames, &PressFrameComparison::similarity),
+      "  bare background " +
+          describeFrameMedians(r.held_out_frames, &PressFrameComparison::bare_background),
+      "fitted presses' " +
+          describeFrameMedians(r.training_frames, &PressFrameComparison::similarity),
   };
 }
 
@@ -94,9 +108,9 @@ cv::Mat3b makeCalibrationReport(const CalibrationResult& result, int max_presses
   result.background.convertTo(background, CV_32F);
   for (int i = 0; i < rows; ++i) {
     const PressObservation& press = result.held_out_presses[i];
-    cv::Mat3b real, render, difference;
+    cv::Mat3b real, difference;
     cv::Mat3f(background + press.diff).convertTo(real, CV_8U);
-    cv::Mat3f(background + result.held_out_simulated[i]).convertTo(render, CV_8U);
+    const cv::Mat3b render = renderedPressFrame(result.background, result.held_out_simulated[i]);
     cv::Mat3f(2.0 * (press.diff - result.held_out_simulated[i]) + cv::Scalar::all(128.0))
         .convertTo(difference, CV_8U);
     const double half = kCropRadii * result.held_out_radii_px[i];

@@ -2,10 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <string>
+
+#include <opencv2/core/utility.hpp>
 
 #include "norm2tex/calibrate/background_noise.hpp"
+#include "norm2tex/calibrate/ball_press.hpp"
 #include "norm2tex/calibrate/press_refinement.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader.hpp"
@@ -66,6 +71,25 @@ void removeDrift(PressObservation& press) {
   press.diff -= cv::Scalar(offset[0], offset[1], offset[2]);
 }
 
+// A press's render at the fitted model against its real frame (the frame as captured).
+PressFrameComparison compareFrames(const PressObservation& press, const cv::Mat3b& real_frame,
+                                   const cv::Mat3b& background, const cv::Mat3f& simulated_diff,
+                                   const SensorModel& model, const PressGeometry& geometry,
+                                   double ball_radius_mm) {
+  PressFrameComparison comparison;
+  comparison.name = press.name;
+  comparison.circle = press.circle;
+  comparison.contact_radius_px = press.circle.radius_px * geometry.radius_factor;
+  comparison.depth_mm =
+      ballPressDepthMm(comparison.contact_radius_px * model.mm_per_pixel, ball_radius_mm);
+  const cv::Mat1b contact =
+      contactDiscMask(real_frame.size(), press.circle.centre_px, comparison.contact_radius_px);
+  comparison.similarity =
+      compareImages(renderedPressFrame(background, simulated_diff), real_frame, contact);
+  comparison.bare_background = compareImages(background, real_frame, contact);
+  return comparison;
+}
+
 }  // namespace
 
 CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
@@ -99,6 +123,7 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
 
   // Contact circles and drift-corrected differences.
   std::vector<PressObservation> training, held_out;
+  std::vector<int> training_index, held_out_index;  // each press's place in the input
   std::set<std::string> labelled;  // presses whose circle the user gave: never refined
   const int n = static_cast<int>(input.presses.size());
   const int held_out_count =
@@ -116,6 +141,7 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
     // count floor((i + 1) k / n) steps up.
     const bool hold = (i + 1) * held_out_count / n > i * held_out_count / n;
     (hold ? held_out : training).push_back(std::move(press));
+    (hold ? held_out_index : training_index).push_back(i);
   }
 
   const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
@@ -157,12 +183,43 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   }());
   result.model.background_image.clear();
 
-  // Held-out presses, rendered by the shader itself at the fitted geometry.
+  // Every press rendered by the shader itself at the fitted geometry: the held-out ones judge
+  // the fit; the fitted ones' frames are compared too (one render each, cheap beside the fit).
+  // Presses on all cores, each into its own slot (DigitShader keeps per-thread scratch).
   const DigitShader shader(result.model, result.background, BackgroundSource::kCaptured);
-  for (PressObservation& press : held_out) {
-    const cv::Mat1f gel =
-        simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm);
-    result.held_out_simulated.push_back(shader.shadingDifference(gel));
+  const int held_out_jobs = static_cast<int>(held_out.size());
+  const int press_count = held_out_jobs + static_cast<int>(training.size());
+  result.held_out_simulated.resize(held_out.size());
+  result.held_out_frames.resize(held_out.size());
+  result.training_frames.resize(training.size());
+  std::mutex error_mutex;
+  std::string error;
+  cv::parallel_for_(cv::Range(0, press_count), [&](const cv::Range& range) {
+    for (int job = range.start; job < range.end; ++job) {
+      const bool is_held_out = job < held_out_jobs;
+      const int i = is_held_out ? job : job - held_out_jobs;
+      const PressObservation& press = is_held_out ? held_out[i] : training[i];
+      const int index = is_held_out ? held_out_index[i] : training_index[i];
+      try {
+        const cv::Mat3f simulated = shader.shadingDifference(
+            simulatedPressGel(result.model, press.circle, result.fit.geometry, ball_radius_mm));
+        PressFrameComparison comparison =
+            compareFrames(press, input.presses[index].image, result.background, simulated,
+                          result.model, result.fit.geometry, ball_radius_mm);
+        comparison.index = index;
+        comparison.held_out = is_held_out;
+        comparison.labelled = labelled.count(press.name) > 0;
+        if (is_held_out) result.held_out_simulated[i] = simulated;
+        (is_held_out ? result.held_out_frames[i] : result.training_frames[i]) =
+            std::move(comparison);
+      } catch (const std::exception& e) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (error.empty()) error = e.what();
+      }
+    }
+  });
+  if (!error.empty()) throw Error(error);
+  for (const PressObservation& press : held_out) {
     result.held_out_radii_px.push_back(press.circle.radius_px * result.fit.geometry.radius_factor);
   }
   result.held_out_presses = std::move(held_out);

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <vector>
 
+#include "common/json_writer.hpp"  // jsonString: file names may hold quotes or backslashes
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -37,24 +38,6 @@ std::string number(float value) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.9g", static_cast<double>(value));
   return text;
-}
-
-// A JSON string literal; file names may hold quotes, backslashes or control characters.
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escape[8];
-      std::snprintf(escape, sizeof(escape), "\\u%04x", static_cast<unsigned>(c));
-      out += escape;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
 }
 
 void append(std::vector<unsigned char>& buffer, const void* data, size_t bytes) {
