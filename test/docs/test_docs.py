@@ -82,6 +82,26 @@ def split_code(text):
     return prose_text, code
 
 
+def fenced_blocks(text):
+    """(info string, line number of the first code line, [code lines]) of every fenced block, in
+    page order (the info string is the fence's language tag: "bash", "python", "" ...)."""
+    blocks, block, info, start, in_fence = [], [], "", 0, False
+    for number, line in enumerate(text.split("\n"), 1):
+        m = _FENCE.match(line.strip())
+        if m:
+            if in_fence:
+                blocks.append((info, start, block))
+            else:
+                info, start, block = line.strip()[3:].strip(), number + 1, []
+            in_fence = not in_fence
+            continue
+        if in_fence:
+            block.append(line)
+    if in_fence:
+        blocks.append((info, start, block))
+    return blocks
+
+
 def _logical_lines(lines):
     out, cur = [], ""
     for line in lines:
