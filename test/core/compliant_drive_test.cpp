@@ -56,6 +56,10 @@ TEST(CompliantDriveTest, FingersSitBackFromTheCommandByForceOverStiffness) {
     const double commanded = sim.gapForOpening(sim.commandedOpening()) / 2.0;
     const double deflection = sim.fingerPosition() - commanded;
     const double force = meanForce(sim);
+    RecordProperty("deflection_um_at_" + std::to_string(static_cast<int>(k_n_per_mm)) + "n_per_mm",
+                   std::to_string(deflection * 1e6));
+    RecordProperty("force_n_at_" + std::to_string(static_cast<int>(k_n_per_mm)) + "n_per_mm",
+                   std::to_string(force));
     EXPECT_GT(deflection, 1e-3) << k_n_per_mm << " N/mm: the finger should sit well back";
     EXPECT_NEAR(deflection, force / config.gripper.stiffness_n_per_m, 0.03 * deflection)
         << k_n_per_mm << " N/mm";
@@ -93,6 +97,8 @@ TEST(CompliantDriveTest, TheGripSettlesWithoutRinging) {
     x_max = std::max(x_max, sim.fingerPosition());
   }
   ASSERT_GT(f_min, 0.5);
+  RecordProperty("held_force_range_n", std::to_string(f_max - f_min));
+  RecordProperty("held_finger_range_um", std::to_string((x_max - x_min) * 1e6));
   EXPECT_LT(f_max - f_min, 0.01 * f_max) << "force " << f_min << " ... " << f_max << " N";
   EXPECT_LT(x_max - x_min, 1e-6) << "finger " << x_min << " ... " << x_max << " m";
   EXPECT_FALSE(sim.dropped());
