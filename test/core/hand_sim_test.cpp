@@ -259,6 +259,37 @@ TEST(HandConfig, ReadsTextAsItReadsFiles) {
                     {"broken urdf:1", "not well-formed XML"});
 }
 
+TEST(HandSim, ResetsWithTheJointsWhereItIsTold) {
+  // How GripperSim seats each episode: the fingers at the seat, the mimic finger with them.
+  GripperSimConfig scene;
+  setGelFromSensor(makeDigitSensorModel(), scene);
+  HandSimConfig config = makeHandSimConfig(
+      std::string(NORM2TEX_SOURCE_DIR) + "/config/hands/parallel_gripper.yaml", scene);
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 0.2));
+  HandSim sim(config);
+  const Eigen::Isometry3d pose = config.object_pose;
+  const int left = sim.description().jointIndex("finger_left_joint");
+  sim.reset(pose, {"finger_left_joint"}, {0.017});
+  EXPECT_EQ(sim.jointPosition("finger_right_joint"), 0.017);
+  EXPECT_EQ(sim.driveJointPositions()[left], 0.017);
+  EXPECT_EQ(sim.jointTargets()[left], 0.017);
+  EXPECT_FALSE(sim.objectReachesIntoGel(0) || sim.objectReachesIntoGel(1));
+  sim.reset(pose, {"finger_left_joint"}, {0.014});  // 1 mm into each side of the 30 mm cube
+  EXPECT_TRUE(sim.objectReachesIntoGel(0) && sim.objectReachesIntoGel(1));
+  sim.reset(pose, {"finger_left_joint"}, {0.5});
+  EXPECT_EQ(sim.jointPosition("finger_left_joint"), 0.02);  // clamped to the URDF's limit
+  test::expectError([&] { sim.reset(pose, {"finger_right_joint"}, {0.01}); },
+                    {"'finger_right_joint' mimics 'finger_left_joint'"});
+  test::expectError([&] { sim.reset(pose, {"finger"}, {0.01}); }, {"unknown joint 'finger'"});
+  test::expectError([&] { sim.reset(pose, {"finger_left_joint"}, {NAN}); }, {"not finite"});
+  test::expectError([&] { sim.reset(pose, {"finger_left_joint"}, {}); },
+                    {"1 names but 0 positions"});
+  EXPECT_EQ(sim.jointPosition("finger_left_joint"), 0.02);  // nothing changed
+  sim.step(10);
+  sim.reset();
+  EXPECT_EQ(sim.jointPosition("finger_left_joint"), 0.02);  // the yaml's initial position
+}
+
 TEST(HandSim, RefusesASensorOnALinkNotInTheHandAndDrivesWithoutLimits) {
   HandSimConfig config = wsgConfig();
   config.hand.sensors[1].link = "finger_right_tipp";
