@@ -36,7 +36,10 @@ norm2tex::cli::Program makeProgram() {
       "norm2tex_calibrate --background BG.png [BG2.png ...] --presses P1.png P2.png ...\n"
       "                          --ball-diameter-mm D [--mm-per-pixel S] [--labels labels.csv]\n"
       "                          [--size WxH] [--sensor base.yaml] [--holdout F]\n"
-      "                          -o SENSOR.yaml [--report REPORT.png] [--json REPORT.json]",
+      "                          -o SENSOR.yaml [--report REPORT.png] [--json REPORT.json]\n"
+      "       norm2tex_calibrate --judge SENSOR.yaml --background BG.png ... --presses P.png ...\n"
+      "                          --ball-diameter-mm D [--labels labels.csv] [--size WxH]\n"
+      "                          [--report REPORT.png] [--json REPORT.json]",
       "Fits a sensor yaml to your DIGIT from no-contact frames and a few ball presses: the scale\n"
       "(unless --mm-per-pixel), the calibrated shading with its rim shadow, and the noise of\n"
       "your no-contact frames, which become the sensor's background (written beside the yaml as\n"
@@ -65,6 +68,10 @@ norm2tex::cli::Program makeProgram() {
        "The sensor yaml to start from (gel, camera); default: the built-in DIGIT.")  //
       ("holdout", po::value<double>()->value_name("F"),
        "The share of the presses held out to judge the fit (default 0.3).")  //
+      ("judge", po::value<std::string>()->value_name("SENSOR.yaml"),
+       "Fit nothing: judge this calibrated sensor on the presses given (another session of the "
+       "same unit, or another unit), every one held out, as a fit's held-out presses are "
+       "judged. Writes no sensor yaml.")  //
       ("output,o", po::value<std::string>()->value_name("SENSOR.yaml"),
        "The fitted sensor yaml.")  //
       ("report", po::value<std::string>()->value_name("REPORT.png"),
@@ -164,8 +171,16 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   if (!args.count("background")) throw UsageError("missing --background");
   if (!args.count("presses")) throw UsageError("missing --presses");
   if (!args.count("ball-diameter-mm")) throw UsageError("missing --ball-diameter-mm");
+  const bool judging = args.count("judge") > 0;
   const std::string output = valueOr<std::string>(args, "output", "");
-  if (output.empty()) throw UsageError("missing -o SENSOR.yaml");
+  if (judging) {
+    if (!output.empty()) throw UsageError("--judge fits nothing: it writes no -o SENSOR.yaml");
+    if (args.count("sensor") || args.count("holdout")) {
+      throw UsageError("--judge takes the calibrated sensor as it is: no --sensor or --holdout");
+    }
+  } else if (output.empty()) {
+    throw UsageError("missing -o SENSOR.yaml");
+  }
   const std::string json_path = valueOr<std::string>(args, "json", "");
   if (args.count("json")) norm2tex::checkJsonReportPath(json_path);  // before the fit's work
 
@@ -190,6 +205,26 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   norm2tex::CalibrationOptions options;
   options.holdout_fraction = valueOr(args, "holdout", options.holdout_fraction);
 
+  if (judging) {
+    const std::string sensor = args["judge"].as<std::string>();
+    const norm2tex::CalibrationResult result =
+        norm2tex::judgeSensor(norm2tex::loadSensorModel(sensor), input);
+    if (args.count("report")) {
+      norm2tex::writeImage(args["report"].as<std::string>(),
+                           norm2tex::makeCalibrationReport(result));
+    }
+    if (args.count("json")) {
+      norm2tex::writeCalibrationReportJson(json_path, result, input.ball_diameter_mm);
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("%s: judged on %zu presses in %.1f s\n", sensor.c_str(), input.presses.size(),
+                seconds);
+    for (const std::string& line : norm2tex::describeFitQuality(result)) {
+      std::printf("  %s\n", line.c_str());
+    }
+    return 0;
+  }
   const norm2tex::SensorModel base = baseModel(args, input.backgrounds.front().image.size());
   const norm2tex::CalibrationResult result = norm2tex::calibrateSensor(base, input, options);
 

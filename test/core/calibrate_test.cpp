@@ -225,6 +225,35 @@ TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
   }
 }
 
+// The shipped sensor, fitted on one session of the unit (vocdex/Taxim sphere2), judged on the
+// other (the fixture: sphere, another day, another background): every press held out, nothing
+// fitted. Goal of the realism work: at least 0.85 of the variance, the rim shadow within 20 %.
+TEST(Calibration, TheShippedSensorIsJudgedOnTheUnitsOtherSession) {
+  CalibrationInput input;
+  input.backgrounds.push_back(fixtureFrame(30));
+  for (int i = 0; i <= 28; i += 2) input.presses.push_back(fixtureFrame(i));
+  input.ball_diameter_mm = 6.0;
+  const SensorModel shipped = loadSensorModel(NORM2TEX_SOURCE_DIR "/config/digit.yaml");
+  const CalibrationResult result = judgeSensor(shipped, input);
+  const FitQuality& q = result.held_out;
+  for (const std::string& line : describeFitQuality(result)) std::printf("%s\n", line.c_str());
+  EXPECT_EQ(result.training_presses, 0);
+  EXPECT_TRUE(result.training_frames.empty());
+  EXPECT_EQ(q.presses, 15);
+  EXPECT_EQ(result.model.shading.response_bgr, shipped.shading.response_bgr);  // nothing fitted
+  EXPECT_GE(q.variance_explained, 0.85);
+  ASSERT_LT(q.real_rim_darkest, -3.0);
+  EXPECT_NEAR(q.sim_rim_darkest / q.real_rim_darkest, 1.0, 0.2);
+  for (int k = 0; k < 3; ++k) EXPECT_LE(q.side_error_deg[k], 15.0) << "channel " << k;
+  EXPECT_EQ(result.held_out_frames.size(), 15u);
+  // The judged sensor's scale is the scale: another one given is refused, not used.
+  input.mm_per_pixel = 0.05;
+  test::expectError([&] { judgeSensor(shipped, input); }, {"0.0532", "leave the scale out"});
+  input.mm_per_pixel.reset();
+  input.presses.clear();
+  test::expectError([&] { judgeSensor(shipped, input); }, {"at least 1 ball press"});
+}
+
 // Without the scale, the real presses do not pin it (ScaleSearch: a response fitted per unit
 // absorbs most of a change of scale, and real presses fit best near the smallest scale
 // searched, as presses rendered with the analytic LEDs do). The calibration must say so: the fit

@@ -90,6 +90,47 @@ TEST_F(CalibrateCli, WritesASensorYamlThatLoadsWithItsBackgroundAndAReport) {
   EXPECT_GT(report.rows, 160);
 }
 
+// --judge fits nothing: the sensor that rendered the presses, judged on them, reproduces them
+// (up to the noise drawn into each); a sensor whose shading is half as strong does not; the
+// sensor yaml is not rewritten.
+TEST_F(CalibrateCli, JudgeRendersAGivenSensorOnThePressesWithoutFitting) {
+  norm2tex::SensorModel truth = norm2tex::makeDigitSensorModel();
+  norm2tex::saveSensorModel(truth, path("truth.yaml"));
+  truth.shading.gain = 0.5;
+  norm2tex::saveSensorModel(truth, path("weak.yaml"));
+  const std::string common =
+      " --background " + path("bg.png") + " --presses" + presses_ + " --ball-diameter-mm 6";
+  const CliRun run = calibrate("--judge " + path("truth.yaml") + common + " --json " +
+                               path("judged.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("judged on 6 presses"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("nothing fitted (judged); 6 presses held out"), std::string::npos)
+      << run.output;
+  const auto explained = [](const std::string& output) {
+    const std::string key = "variance explained ";
+    const size_t at = output.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(output.substr(at + key.size()));
+  };
+  EXPECT_GT(explained(run.output), 0.95) << run.output;
+  const YAML::Node report = YAML::LoadFile(path("judged.json"));  // JSON is YAML
+  EXPECT_TRUE(report["judged"].as<bool>());
+  EXPECT_TRUE(report["fitted"].IsNull());
+  EXPECT_EQ(report["held_out"]["presses"].as<int>(), 6);
+  EXPECT_EQ(report["presses"].size(), 6u);
+  const CliRun weak = calibrate("--judge " + path("weak.yaml") + common);
+  ASSERT_EQ(weak.exit_code, 0) << weak.output;
+  EXPECT_LT(explained(weak.output), explained(run.output) - 0.1) << weak.output;
+  EXPECT_FALSE(std::filesystem::exists(path("truth_background.png")));
+  // Fitting options have no place in a judgement: usage errors.
+  EXPECT_EQ(calibrate("--judge " + path("truth.yaml") + common + " -o " + path("x.yaml"))
+                .exit_code,
+            2);
+  EXPECT_EQ(calibrate("--judge " + path("truth.yaml") + common + " --holdout 0.5").exit_code, 2);
+  const CliRun missing = calibrate("--judge " + path("none.yaml") + common);
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const size_t n = values.size();
