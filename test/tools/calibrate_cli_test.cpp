@@ -131,6 +131,37 @@ TEST_F(CalibrateCli, JudgeRendersAGivenSensorOnThePressesWithoutFitting) {
   EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
 }
 
+// Two frames of the ball moved 8 mm between them measure the scale, which the fit then uses as
+// given; the scale is given once.
+TEST_F(CalibrateCli, TwoPressesAKnownDistanceApartGiveTheScale) {
+  const norm2tex::SensorModel m = norm2tex::makeDigitSensorModel();
+  const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m.imageSize()),
+                                     norm2tex::BackgroundSource::kSynthetic);
+  for (const double x_mm : {-4.0, 4.0}) {
+    const norm2tex::PressCircle circle{{x_mm / m.mm_per_pixel + 119.5, 159.5},
+                                       1.5 / m.mm_per_pixel};
+    cv::Mat1f gel;
+    norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+    cv::imwrite(path(x_mm < 0 ? "left.png" : "right.png"), shader.shade(gel, 30));
+  }
+  const std::string common = "--background " + path("bg.png") + " --presses" + presses_ +
+                             " --ball-diameter-mm 6 -o " + path("scaled.yaml") +
+                             " --scale-presses " + path("left.png") + " " + path("right.png");
+  const CliRun run = calibrate(common + " --scale-distance-mm 8");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("scale from the two presses"), std::string::npos) << run.output;
+  const double scale = norm2tex::loadSensorModel(path("scaled.yaml")).mm_per_pixel;
+  EXPECT_NEAR(scale / m.mm_per_pixel, 1.0, 0.01) << run.output;
+  EXPECT_EQ(calibrate(common).exit_code, 2);  // without its distance
+  EXPECT_EQ(calibrate(common + " --scale-distance-mm 8 --mm-per-pixel 0.05").exit_code, 2);
+  const CliRun same = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                                " --ball-diameter-mm 6 -o " + path("x.yaml") + " --scale-presses " +
+                                path("left.png") + " " + path("left.png") +
+                                " --scale-distance-mm 8");
+  EXPECT_EQ(same.exit_code, 1) << same.output;
+  EXPECT_NE(same.output.find("too close"), std::string::npos) << same.output;
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const size_t n = values.size();
