@@ -14,6 +14,7 @@
 
 #include "cli_arguments.hpp"
 #include "norm2tex/calibrate/calibration_json.hpp"
+#include "norm2tex/calibrate/press_scale.hpp"
 #include "norm2tex/calibrate/calibration_report.hpp"
 #include "norm2tex/calibrate/press_labels.hpp"
 #include "norm2tex/calibrate/sensor_calibration.hpp"
@@ -36,7 +37,11 @@ norm2tex::cli::Program makeProgram() {
       "norm2tex_calibrate --background BG.png [BG2.png ...] --presses P1.png P2.png ...\n"
       "                          --ball-diameter-mm D [--mm-per-pixel S] [--labels labels.csv]\n"
       "                          [--size WxH] [--sensor base.yaml] [--holdout F]\n"
-      "                          -o SENSOR.yaml [--report REPORT.png] [--json REPORT.json]",
+      "                          [--scale-presses A.png B.png --scale-distance-mm D]\n"
+      "                          -o SENSOR.yaml [--report REPORT.png] [--json REPORT.json]\n"
+      "       norm2tex_calibrate --judge SENSOR.yaml --background BG.png ... --presses P.png ...\n"
+      "                          --ball-diameter-mm D [--labels labels.csv] [--size WxH]\n"
+      "                          [--report REPORT.png] [--json REPORT.json]",
       "Fits a sensor yaml to your DIGIT from no-contact frames and a few ball presses: the scale\n"
       "(unless --mm-per-pixel), the calibrated shading with its rim shadow, and the noise of\n"
       "your no-contact frames, which become the sensor's background (written beside the yaml as\n"
@@ -65,6 +70,17 @@ norm2tex::cli::Program makeProgram() {
        "The sensor yaml to start from (gel, camera); default: the built-in DIGIT.")  //
       ("holdout", po::value<double>()->value_name("F"),
        "The share of the presses held out to judge the fit (default 0.3).")  //
+      ("scale-presses",
+       po::value<std::vector<std::string>>()->multitoken()->value_name("A.png B.png"),
+       "Two frames of a press (the ball, or a pin) moved --scale-distance-mm along the gel "
+       "between them: the distance between their contact centres measures the scale, used as "
+       "--mm-per-pixel would be.")  //
+      ("scale-distance-mm", po::value<double>()->value_name("D"),
+       "How far the press moved between the two --scale-presses frames, mm.")  //
+      ("judge", po::value<std::string>()->value_name("SENSOR.yaml"),
+       "Fit nothing: judge this calibrated sensor on the presses given (another session of the "
+       "same unit, or another unit), every one held out, as a fit's held-out presses are "
+       "judged. Writes no sensor yaml.")  //
       ("output,o", po::value<std::string>()->value_name("SENSOR.yaml"),
        "The fitted sensor yaml.")  //
       ("report", po::value<std::string>()->value_name("REPORT.png"),
@@ -164,8 +180,16 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   if (!args.count("background")) throw UsageError("missing --background");
   if (!args.count("presses")) throw UsageError("missing --presses");
   if (!args.count("ball-diameter-mm")) throw UsageError("missing --ball-diameter-mm");
+  const bool judging = args.count("judge") > 0;
   const std::string output = valueOr<std::string>(args, "output", "");
-  if (output.empty()) throw UsageError("missing -o SENSOR.yaml");
+  if (judging) {
+    if (!output.empty()) throw UsageError("--judge fits nothing: it writes no -o SENSOR.yaml");
+    if (args.count("sensor") || args.count("holdout")) {
+      throw UsageError("--judge takes the calibrated sensor as it is: no --sensor or --holdout");
+    }
+  } else if (output.empty()) {
+    throw UsageError("missing -o SENSOR.yaml");
+  }
   const std::string json_path = valueOr<std::string>(args, "json", "");
   if (args.count("json")) norm2tex::checkJsonReportPath(json_path);  // before the fit's work
 
@@ -184,12 +208,62 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   if (input.mm_per_pixel && !(*input.mm_per_pixel > 0.0 && *input.mm_per_pixel <= 1.0)) {
     throw UsageError("--mm-per-pixel must be in (0, 1]");
   }
+  if (args.count("scale-presses") != args.count("scale-distance-mm")) {
+    throw UsageError("--scale-presses and --scale-distance-mm go together");
+  }
+  if (args.count("scale-presses")) {
+    if (args.count("mm-per-pixel")) {
+      throw UsageError("give the scale once: --mm-per-pixel or --scale-presses");
+    }
+    const auto paths = args["scale-presses"].as<std::vector<std::string>>();
+    if (paths.size() != 2) throw UsageError("--scale-presses takes exactly two frames");
+    const norm2tex::NamedFrame a = loadFrame(paths[0], size), b = loadFrame(paths[1], size);
+    // The mean no-contact frame, as the calibration takes it.
+    cv::Mat3f sum(input.backgrounds.front().image.size(), cv::Vec3f(0, 0, 0));
+    for (const norm2tex::NamedFrame& frame : input.backgrounds) {
+      if (frame.image.size() != sum.size()) break;  // the calibration names the odd frame
+      cv::Mat3f f;
+      frame.image.convertTo(f, CV_32F);
+      sum += f;
+    }
+    cv::Mat3b background;
+    cv::Mat3f(sum / static_cast<double>(input.backgrounds.size())).convertTo(background, CV_8U);
+    const norm2tex::PressScale scale = norm2tex::measureScaleFromTwoPresses(
+        background, a.image, a.name, b.image, b.name, args["scale-distance-mm"].as<double>());
+    std::printf("scale from the two presses: %.1f px apart, %.5f mm/px\n", scale.distance_px,
+                scale.mm_per_pixel);
+    if (!(scale.mm_per_pixel <= 1.0)) {
+      throw Error("the scale presses give " + std::to_string(scale.mm_per_pixel) +
+                  " mm/px, more than 1: check --scale-distance-mm");
+    }
+    input.mm_per_pixel = scale.mm_per_pixel;
+  }
   if (args.count("labels")) {
     input.labels = loadLabels(args["labels"].as<std::string>(), input.presses);
   }
   norm2tex::CalibrationOptions options;
   options.holdout_fraction = valueOr(args, "holdout", options.holdout_fraction);
 
+  if (judging) {
+    const std::string sensor = args["judge"].as<std::string>();
+    const norm2tex::CalibrationResult result =
+        norm2tex::judgeSensor(norm2tex::loadSensorModel(sensor), input);
+    if (args.count("report")) {
+      norm2tex::writeImage(args["report"].as<std::string>(),
+                           norm2tex::makeCalibrationReport(result));
+    }
+    if (args.count("json")) {
+      norm2tex::writeCalibrationReportJson(json_path, result, input.ball_diameter_mm);
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("%s: judged on %zu presses in %.1f s\n", sensor.c_str(), input.presses.size(),
+                seconds);
+    for (const std::string& line : norm2tex::describeFitQuality(result)) {
+      std::printf("  %s\n", line.c_str());
+    }
+    return 0;
+  }
   const norm2tex::SensorModel base = baseModel(args, input.backgrounds.front().image.size());
   const norm2tex::CalibrationResult result = norm2tex::calibrateSensor(base, input, options);
 

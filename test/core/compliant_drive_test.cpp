@@ -56,6 +56,10 @@ TEST(CompliantDriveTest, FingersSitBackFromTheCommandByForceOverStiffness) {
     const double commanded = sim.gapForOpening(sim.commandedOpening()) / 2.0;
     const double deflection = sim.fingerPosition() - commanded;
     const double force = meanForce(sim);
+    RecordProperty("deflection_um_at_" + std::to_string(static_cast<int>(k_n_per_mm)) + "n_per_mm",
+                   std::to_string(deflection * 1e6));
+    RecordProperty("force_n_at_" + std::to_string(static_cast<int>(k_n_per_mm)) + "n_per_mm",
+                   std::to_string(force));
     EXPECT_GT(deflection, 1e-3) << k_n_per_mm << " N/mm: the finger should sit well back";
     EXPECT_NEAR(deflection, force / config.gripper.stiffness_n_per_m, 0.03 * deflection)
         << k_n_per_mm << " N/mm";
@@ -93,8 +97,44 @@ TEST(CompliantDriveTest, TheGripSettlesWithoutRinging) {
     x_max = std::max(x_max, sim.fingerPosition());
   }
   ASSERT_GT(f_min, 0.5);
+  RecordProperty("held_force_range_n", std::to_string(f_max - f_min));
+  RecordProperty("held_finger_range_um", std::to_string((x_max - x_min) * 1e6));
   EXPECT_LT(f_max - f_min, 0.01 * f_max) << "force " << f_min << " ... " << f_max << " N";
   EXPECT_LT(x_max - x_min, 1e-6) << "finger " << x_min << " ... " << x_max << " m";
+  EXPECT_FALSE(sim.dropped());
+}
+
+TEST(CompliantDriveTest, ASqueezeSettlesWithoutOvershoot) {
+  // From the grasp, commanded 4 mm narrower at once on a 5 N/mm drive: the drive travels at its
+  // speed limit and the fingers follow it through their springs into the gels. One drive for
+  // both fingers: the gels' forces differ only while the cube shifts between them. The report
+  // (JUnit XML) keeps the overshoot of the mean force, the largest difference between the gels
+  // and the ticks to settle within 1 %.
+  GripperSim sim(compliantCube(5.0));
+  const EpisodeStart start = sim.reset(2, 0.0);
+  sim.setOpening(start.grasp_opening - 0.1);
+  std::vector<double> mean;
+  double largest_difference = 0.0;
+  for (int t = 0; t < 3000; ++t) {
+    sim.step(1);
+    mean.push_back(meanForce(sim));
+    largest_difference =
+        std::max(largest_difference, std::abs(sim.contact(Finger::kLeft).normal_force_n -
+                                              sim.contact(Finger::kRight).normal_force_n));
+  }
+  const double settled = mean.back();
+  const double peak = *std::max_element(mean.begin(), mean.end());
+  int settling_ticks = 0;
+  for (int t = 0; t < static_cast<int>(mean.size()); ++t) {
+    if (std::abs(mean[t] - settled) > 0.01 * settled) settling_ticks = t + 1;
+  }
+  RecordProperty("settled_force_n", std::to_string(settled));
+  RecordProperty("overshoot_percent", std::to_string((peak / settled - 1.0) * 100.0));
+  RecordProperty("largest_gel_difference_n", std::to_string(largest_difference));
+  RecordProperty("settling_ticks", std::to_string(settling_ticks));
+  EXPECT_LT(peak, 1.01 * settled);
+  EXPECT_LT(largest_difference, 0.05 * settled);
+  EXPECT_LT(settling_ticks, 1500);  // the drive's 2 mm at 20 mm/s take 100 ticks
   EXPECT_FALSE(sim.dropped());
 }
 

@@ -273,6 +273,9 @@ TEST_P(GraspObjectTest, HoldsStillForTenSecondsWithBothGelsAlike) {
   RecordProperty("drift_um", std::to_string((after.translation() - before.translation()).norm() * 1e6));
   RecordProperty("tilt_mdeg", std::to_string(rotationDeg(before, after) * 1e3));
   RecordProperty("indentation_um", std::to_string(left.penetration_m * 1e6));
+  RecordProperty("indentation_right_um", std::to_string(right.penetration_m * 1e6));
+  RecordProperty("force_left_n", std::to_string(left.normal_force_n));
+  RecordProperty("force_right_n", std::to_string(right.normal_force_n));
   EXPECT_LT((after.translation() - before.translation()).norm(), 0.2e-3);
   EXPECT_LT(rotationDeg(before, after), 0.5);
   EXPECT_LT(largest_step, 1e-5);  // never faster than 1 cm/s
@@ -326,6 +329,7 @@ TEST_P(GraspObjectTest, OpeningSlowlyDropsIt) {
     }
   }
   EXPECT_TRUE(sim.dropped());
+  RecordProperty("dropped_at_opening", std::to_string(sim.commandedOpening()));
   // It falls (at most ~0.4 mm per 1 ms tick at the ~0.05 m it may fall) but is never flung.
   EXPECT_LT(largest_step, 2e-3);
   EXPECT_LT(std::abs(sim.objectInWorld().translation().y()), 0.05);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -235,6 +236,58 @@ TEST(HandConfig, ReadsTheYamlAndRefusesWhatIsNotThere) {
         "hand: {urdf: " + urdf + "}\nsensors: [{name: a, link: b}]\njoints: {j: {effort: -1}}\n");
   test::expectError([&] { loadHandConfig(dir.path("drive.yaml")); },
                     {"joints.j.effort", "valid: > 0"});
+}
+
+TEST(HandConfig, ReadsTextAsItReadsFiles) {
+  // The built-in gripper's way in: yaml and URDF text, relative paths against a folder given.
+  const std::string hands = std::string(NORM2TEX_SOURCE_DIR) + "/config/hands";
+  const HandConfig file = loadHandConfig(hands + "/parallel_gripper.yaml");
+  std::ifstream yaml_file(hands + "/parallel_gripper.yaml");
+  const std::string yaml((std::istreambuf_iterator<char>(yaml_file)), {});
+  const HandConfig text = parseHandConfig(yaml, "gripper text", hands);
+  EXPECT_EQ(text.urdf_path, file.urdf_path);
+  ASSERT_EQ(text.sensors.size(), 2u);
+  EXPECT_TRUE(text.sensors[1].digit_in_link.matrix() == file.sensors[1].digit_in_link.matrix());
+  test::expectError([] { parseHandConfig("hand: [", "broken text", "."); }, {"broken text"});
+  std::ifstream urdf_file(file.urdf_path);
+  const std::string urdf((std::istreambuf_iterator<char>(urdf_file)), {});
+  const HandDescription description = parseHandDescription(urdf, "gripper urdf", hands, {});
+  EXPECT_EQ(description.joints.size(), 2u);
+  EXPECT_EQ(description.joints[description.jointIndex("finger_right_joint")].mimic_master,
+            description.jointIndex("finger_left_joint"));
+  test::expectError([] { parseHandDescription("<robot", "broken urdf", ".", {}); },
+                    {"broken urdf:1", "not well-formed XML"});
+}
+
+TEST(HandSim, ResetsWithTheJointsWhereItIsTold) {
+  // How GripperSim seats each episode: the fingers at the seat, the mimic finger with them.
+  GripperSimConfig scene;
+  setGelFromSensor(makeDigitSensorModel(), scene);
+  HandSimConfig config = makeHandSimConfig(
+      std::string(NORM2TEX_SOURCE_DIR) + "/config/hands/parallel_gripper.yaml", scene);
+  config.object_pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 0.2));
+  HandSim sim(config);
+  const Eigen::Isometry3d pose = config.object_pose;
+  const int left = sim.description().jointIndex("finger_left_joint");
+  sim.reset(pose, {"finger_left_joint"}, {0.017});
+  EXPECT_EQ(sim.jointPosition("finger_right_joint"), 0.017);
+  EXPECT_EQ(sim.driveJointPositions()[left], 0.017);
+  EXPECT_EQ(sim.jointTargets()[left], 0.017);
+  EXPECT_FALSE(sim.objectReachesIntoGel(0) || sim.objectReachesIntoGel(1));
+  sim.reset(pose, {"finger_left_joint"}, {0.014});  // 1 mm into each side of the 30 mm cube
+  EXPECT_TRUE(sim.objectReachesIntoGel(0) && sim.objectReachesIntoGel(1));
+  sim.reset(pose, {"finger_left_joint"}, {0.5});
+  EXPECT_EQ(sim.jointPosition("finger_left_joint"), 0.02);  // clamped to the URDF's limit
+  test::expectError([&] { sim.reset(pose, {"finger_right_joint"}, {0.01}); },
+                    {"'finger_right_joint' mimics 'finger_left_joint'"});
+  test::expectError([&] { sim.reset(pose, {"finger"}, {0.01}); }, {"unknown joint 'finger'"});
+  test::expectError([&] { sim.reset(pose, {"finger_left_joint"}, {NAN}); }, {"not finite"});
+  test::expectError([&] { sim.reset(pose, {"finger_left_joint"}, {}); },
+                    {"1 names but 0 positions"});
+  EXPECT_EQ(sim.jointPosition("finger_left_joint"), 0.02);  // nothing changed
+  sim.step(10);
+  sim.reset();
+  EXPECT_EQ(sim.jointPosition("finger_left_joint"), 0.02);  // the yaml's initial position
 }
 
 TEST(HandSim, RefusesASensorOnALinkNotInTheHandAndDrivesWithoutLimits) {

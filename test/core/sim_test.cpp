@@ -1,6 +1,7 @@
 // GripperSim, GelLaw, the scene config and ContactPatch, without ROS: physical expectations
 // (a held cube stays, harder squeeze = deeper and larger contact following the law, friction
 // and mass decide where it drops), determinism, resets, and bad input.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -79,6 +80,12 @@ TEST(GripperSimTest, HeldCubeStaysPutForTenSeconds) {
   const Eigen::Isometry3d before = sim.objectInWorld();
   sim.step(10000);  // 10 s at 1 kHz
   const Eigen::Isometry3d after = sim.objectInWorld();
+  RecordProperty("drift_um",
+                 std::to_string((after.translation() - before.translation()).norm() * 1e6));
+  RecordProperty("indentation_left_um",
+                 std::to_string(sim.contact(Finger::kLeft).penetration_m * 1e6));
+  RecordProperty("indentation_right_um",
+                 std::to_string(sim.contact(Finger::kRight).penetration_m * 1e6));
   EXPECT_LT((after.translation() - before.translation()).norm(), 0.2e-3);
   EXPECT_LT(rotationDeg(before, after), 0.5);
   EXPECT_FALSE(sim.dropped());
@@ -115,7 +122,16 @@ TEST(GripperSimTest, SqueezingHarderFollowsTheGelLaw) {
   EXPECT_NEAR(0.030 - gap, 2.0 * sim.contact(Finger::kLeft).penetration_m, 2e-5);
   // ... up to the force limit, where the fingers stop.
   sim.setOpening(0.0);
-  sim.step(2000);
+  double peak_force = 0.0;
+  for (int t = 0; t < 2000; ++t) {
+    sim.step(1);
+    peak_force = std::max({peak_force, sim.contact(Finger::kLeft).normal_force_n,
+                           sim.contact(Finger::kRight).normal_force_n});
+  }
+  RecordProperty("force_limit_peak_n", std::to_string(peak_force));
+  RecordProperty("force_limit_left_n", std::to_string(sim.contact(Finger::kLeft).normal_force_n));
+  RecordProperty("force_limit_right_n", std::to_string(sim.contact(Finger::kRight).normal_force_n));
+  RecordProperty("force_limit_opening", std::to_string(sim.opening()));
   EXPECT_NEAR(sim.contact(Finger::kLeft).normal_force_n, config.gripper.max_force_n,
               0.05 * config.gripper.max_force_n);
   EXPECT_GT(sim.opening(), 0.5);
@@ -128,6 +144,10 @@ TEST(GripperSimTest, DropOpeningGrowsWithFrictionAndShrinksWithMass) {
   const double heavy_drop = slipOpening(heavy), light_drop = slipOpening(light);
   ASSERT_TRUE(std::isfinite(slippery_drop) && std::isfinite(grippy_drop));
   ASSERT_TRUE(std::isfinite(heavy_drop) && std::isfinite(light_drop));
+  RecordProperty("slip_opening_mu03_100g", std::to_string(slippery_drop));
+  RecordProperty("slip_opening_mu08_100g", std::to_string(grippy_drop));
+  RecordProperty("slip_opening_mu05_200g", std::to_string(heavy_drop));
+  RecordProperty("slip_opening_mu05_50g", std::to_string(light_drop));
   EXPECT_GT(grippy_drop, slippery_drop);
   EXPECT_LT(heavy_drop, light_drop);
   EXPECT_TRUE(heavy.dropped());

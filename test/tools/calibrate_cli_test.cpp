@@ -90,6 +90,78 @@ TEST_F(CalibrateCli, WritesASensorYamlThatLoadsWithItsBackgroundAndAReport) {
   EXPECT_GT(report.rows, 160);
 }
 
+// --judge fits nothing: the sensor that rendered the presses, judged on them, reproduces them
+// (up to the noise drawn into each); a sensor whose shading is half as strong does not; the
+// sensor yaml is not rewritten.
+TEST_F(CalibrateCli, JudgeRendersAGivenSensorOnThePressesWithoutFitting) {
+  norm2tex::SensorModel truth = norm2tex::makeDigitSensorModel();
+  norm2tex::saveSensorModel(truth, path("truth.yaml"));
+  truth.shading.gain = 0.5;
+  norm2tex::saveSensorModel(truth, path("weak.yaml"));
+  const std::string common =
+      " --background " + path("bg.png") + " --presses" + presses_ + " --ball-diameter-mm 6";
+  const CliRun run = calibrate("--judge " + path("truth.yaml") + common + " --json " +
+                               path("judged.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("judged on 6 presses"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("nothing fitted (judged); 6 presses held out"), std::string::npos)
+      << run.output;
+  const auto explained = [](const std::string& output) {
+    const std::string key = "variance explained ";
+    const size_t at = output.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(output.substr(at + key.size()));
+  };
+  EXPECT_GT(explained(run.output), 0.95) << run.output;
+  const YAML::Node report = YAML::LoadFile(path("judged.json"));  // JSON is YAML
+  EXPECT_TRUE(report["judged"].as<bool>());
+  EXPECT_TRUE(report["fitted"].IsNull());
+  EXPECT_EQ(report["held_out"]["presses"].as<int>(), 6);
+  EXPECT_EQ(report["presses"].size(), 6u);
+  const CliRun weak = calibrate("--judge " + path("weak.yaml") + common);
+  ASSERT_EQ(weak.exit_code, 0) << weak.output;
+  EXPECT_LT(explained(weak.output), explained(run.output) - 0.1) << weak.output;
+  EXPECT_FALSE(std::filesystem::exists(path("truth_background.png")));
+  // Fitting options have no place in a judgement: usage errors.
+  EXPECT_EQ(calibrate("--judge " + path("truth.yaml") + common + " -o " + path("x.yaml"))
+                .exit_code,
+            2);
+  EXPECT_EQ(calibrate("--judge " + path("truth.yaml") + common + " --holdout 0.5").exit_code, 2);
+  const CliRun missing = calibrate("--judge " + path("none.yaml") + common);
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
+}
+
+// Two frames of the ball moved 8 mm between them measure the scale, which the fit then uses as
+// given; the scale is given once.
+TEST_F(CalibrateCli, TwoPressesAKnownDistanceApartGiveTheScale) {
+  const norm2tex::SensorModel m = norm2tex::makeDigitSensorModel();
+  const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m.imageSize()),
+                                     norm2tex::BackgroundSource::kSynthetic);
+  for (const double x_mm : {-4.0, 4.0}) {
+    const norm2tex::PressCircle circle{{x_mm / m.mm_per_pixel + 119.5, 159.5},
+                                       1.5 / m.mm_per_pixel};
+    cv::Mat1f gel;
+    norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+    cv::imwrite(path(x_mm < 0 ? "left.png" : "right.png"), shader.shade(gel, 30));
+  }
+  const std::string common = "--background " + path("bg.png") + " --presses" + presses_ +
+                             " --ball-diameter-mm 6 -o " + path("scaled.yaml") +
+                             " --scale-presses " + path("left.png") + " " + path("right.png");
+  const CliRun run = calibrate(common + " --scale-distance-mm 8");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("scale from the two presses"), std::string::npos) << run.output;
+  const double scale = norm2tex::loadSensorModel(path("scaled.yaml")).mm_per_pixel;
+  EXPECT_NEAR(scale / m.mm_per_pixel, 1.0, 0.01) << run.output;
+  EXPECT_EQ(calibrate(common).exit_code, 2);  // without its distance
+  EXPECT_EQ(calibrate(common + " --scale-distance-mm 8 --mm-per-pixel 0.05").exit_code, 2);
+  const CliRun same = calibrate("--background " + path("bg.png") + " --presses" + presses_ +
+                                " --ball-diameter-mm 6 -o " + path("x.yaml") + " --scale-presses " +
+                                path("left.png") + " " + path("left.png") +
+                                " --scale-distance-mm 8");
+  EXPECT_EQ(same.exit_code, 1) << same.output;
+  EXPECT_NE(same.output.find("too close"), std::string::npos) << same.output;
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const size_t n = values.size();

@@ -70,4 +70,13 @@ constexpr int kMinCalibrationPresses = 4;
 CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
                                   const CalibrationOptions& options = {});
 
+/// Judges a calibrated sensor on presses it was not fitted on (another session of the same
+/// unit, or another unit): every press is held out. The circles are found as the calibration
+/// finds its held-out presses' (detected or labelled, drift removed, refined against `fitted`,
+/// geometry only); each is rendered by `fitted` on the mean of these backgrounds and compared
+/// (held_out, held_out_frames). Nothing is fitted: result.model is `fitted`, training_presses 0,
+/// fit.geometry its scale with radius factor 1. Throws Error as calibrateSensor does (one press
+/// is enough), and for an input.mm_per_pixel other than the sensor's.
+CalibrationResult judgeSensor(const SensorModel& fitted, const CalibrationInput& input);
+
 }  // namespace norm2tex

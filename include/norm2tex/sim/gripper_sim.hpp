@@ -1,12 +1,10 @@
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -14,9 +12,9 @@
 #include "norm2tex/sim/gel_contact.hpp"
 #include "norm2tex/sim/gripper_sim_config.hpp"
 
-class btCollisionShape;
-
 namespace norm2tex {
+
+class HandSim;
 
 enum class Finger { kLeft = 0, kRight = 1 };
 
@@ -57,7 +55,10 @@ struct ObjectCollision {
   double hull_deviation_m = 0.0;
 };
 
-/// A Bullet simulation of a parallel gripper whose two DIGIT gels hold an object.
+/// A Bullet simulation of a parallel gripper whose two DIGIT gels hold an object: the built-in
+/// hand, config/hands/parallel_gripper.urdf and .yaml (compiled into the library), run by
+/// HandSim with the scene's stroke, speed, force and stiffness; GripperSim adds the episodes
+/// (reset(): seat, grasp, settle) and the drop latch.
 ///
 /// World frame: z up, floor at z = 0. The gripper base sits at (0, 0, base_height) with the
 /// world's orientation; the fingers move along its y axis, the left finger at +y (REP-103:
@@ -75,12 +76,14 @@ struct ObjectCollision {
 /// most the gel's thickness), so at rest the object sinks into each gel exactly as deep as the
 /// law says for the force it carries.
 ///
-/// Fingers are position-controlled at max_speed, coupled (both at the same distance from the
-/// centre plane), and stop closing once either gel carries max_force: the grip force then comes
-/// from the gel law, and a command narrower than the object indents both gels. With
-/// gripper.stiffness_n_per_m = k > 0 the drive is compliant: each finger sits back from the
-/// commanded position by F / k (F the mean gel force), reached by one Newton step of the
-/// series equilibrium per tick (see compliantFingerPosition); k = 0 is rigid.
+/// Fingers are position-controlled at max_speed, coupled (the right finger's joint mimics the
+/// left's: both at the same distance from the centre plane), by one drive whose effort is
+/// 2 x max_force: a command narrower than the object indents both gels until together they carry
+/// it (max_force each when the object sits still between them), the drive advancing and
+/// yielding by one Newton step a tick with the gel law's stiffness (HandSim). With
+/// gripper.stiffness_n_per_m = k > 0 the drive is compliant: its stiffness is 2 k, so each
+/// finger sits back from the commanded position by F / k (F the mean gel force), reached by one
+/// Newton step of the series equilibrium per tick; k = 0 is rigid.
 ///
 /// Deterministic: the same config, reset seeds and commands give bit-identical trajectories.
 class GripperSim {
@@ -130,11 +133,9 @@ class GripperSim {
   void step(int ticks = 1);
   double tickSeconds() const { return 1.0 / config_.physics.rate_hz; }
   /// Ticks since construction (resets keep counting: simulated time never goes back).
-  std::int64_t ticks() const { return ticks_; }
+  std::int64_t ticks() const;
 
-  const GelContactState& contact(Finger finger) const {
-    return contacts_[static_cast<int>(finger)];
-  }
+  const GelContactState& contact(Finger finger) const;
   Eigen::Isometry3d objectInWorld() const;
   Eigen::Isometry3d baseInWorld() const;
   /// Finger frame in the base frame: (0, +-position, 0), no rotation.
@@ -145,56 +146,35 @@ class GripperSim {
   /// Prismatic joint position of a finger: distance of its undeformed gel surface from the
   /// centre plane, metres (both fingers are equal: they are coupled). Where the finger is, not
   /// where it is commanded: a compliant drive leaves it further out.
-  double fingerPosition() const { return finger_position_m_; }
-  /// Latched once the object has left both gels and fallen below their lower edge; cleared
-  /// by reset().
+  double fingerPosition() const;
+  /// Latched once the object has left both gels and fallen below their lower edge at the end of
+  /// a tick; cleared by reset().
   bool dropped() const { return dropped_; }
 
   const GripperSimConfig& config() const { return config_; }
-  const ObjectMesh& object() const { return object_; }
+  const ObjectMesh& object() const;
   /// Convex pieces the object collides as: 1 for a box or a hull, more for a decomposition.
-  int collisionPartCount() const { return collision_.parts; }
-  const ObjectCollision& collision() const { return collision_; }
+  int collisionPartCount() const { return collision().parts; }
+  const ObjectCollision& collision() const;
 
  private:
-  struct World;  // the Bullet objects
-
-  /// Chooses the object's collision (see ObjectOptions::collision) about the body origin.
-  void makeCollision(const Eigen::Vector3d& centre);
-  void findHeightOffsetRange(const Eigen::Vector3d& centre);
-  void buildWorld(double object_height_m);
-  void moveFingers(double dt);
-  /// The finger position one step closer to the series equilibrium with the drive
-  /// (gripper.stiffness_n_per_m > 0), moving at most `max_move`.
-  double compliantFingerPosition(double max_move) const;
-  /// How far a finger sits back from its drive when its gel is indented `depth`, m (0: rigid).
-  double drivePreload(double depth) const;
-  void measureContacts(double dt);
+  void findHeightOffsetRange();
+  /// The object frame's pose with its body (its bounds' centre) `offset_m` above the gel
+  /// centres, unrotated.
+  Eigen::Isometry3d seatedObjectPose(double offset_m) const;
+  /// Sets the command and the drive's target: the finger joint at half the gap.
+  void command(double opening);
   /// Closes from the open seat until both gels touch, then to the configured grip.
   double closeOnTheObject(double offset_m);
+  /// How far a finger sits back from its drive when its gel is indented `depth`, m (0: rigid).
+  double drivePreload(double depth) const;
   double objectWidthM() const;
-  double objectMinHalfSizeM() const;
 
   GripperSimConfig config_;
-  ObjectMesh object_;
-  /// Object frame in the collision body's frame (the body sits at the bounds' centre).
-  Eigen::Isometry3d object_in_body_ = Eigen::Isometry3d::Identity();
-  /// The object's Bullet shape (for the floor and its inertia) is back(); any shapes before it
-  /// are its convex parts.
-  std::vector<std::unique_ptr<btCollisionShape>> object_shapes_;
-  /// What the gels touch, in the body frame: convex parts, or one capsule (a sphere: a == b).
-  std::vector<ConvexPolytope> contact_parts_;
-  std::optional<Capsule> contact_capsule_;
-  ObjectCollision collision_;
+  std::unique_ptr<HandSim> hand_;
+  int finger_joint_ = 0;  ///< the left finger's joint, the drive's (the right one mimics it)
   std::pair<double, double> height_offset_range_;
-  std::unique_ptr<World> world_;
-  std::vector<GelContactState> contacts_ = std::vector<GelContactState>(2);  ///< left, right
   double command_ = 1.0;
-  double finger_position_m_ = 0.0;
-  /// Where the drive has brought the fingers (the command, speed- and force-limited); the
-  /// fingers sit back from it by the drive's deflection (gripper.stiffness_n_per_m).
-  double drive_position_m_ = 0.0;
-  std::int64_t ticks_ = 0;
   std::uint32_t episode_ = 0;
   bool dropped_ = false;
 };

@@ -15,7 +15,9 @@ struct GripperOptions {
   /// Gap between the two undeformed gel surfaces at opening 0 (closed) and 1 (fully open), m.
   double min_gap_m = 0.0;
   double max_gap_m = 0.040;
-  double max_force_n = 35.0;    ///< force limit: the fingers stop closing at this gel force
+  /// Force limit per gel: the drive closes both fingers with at most twice this (the sum of the
+  /// gels' forces), so a squeeze stops where each gel carries it.
+  double max_force_n = 35.0;
   double max_speed_m_s = 0.02;  ///< finger speed (each finger), metres per second
   /// Stiffness of each finger's drive (servo position loop, linkage, printed finger) in series
   /// with its gel, N/m: a finger sits back from its commanded position by F / stiffness, F the

@@ -53,6 +53,10 @@ struct HandConfig {
 /// Reads a hand yaml. Every key is optional but hand.urdf and sensors; unknown keys are errors
 /// naming the key and the valid ones. Throws Error naming the file and the key at fault.
 HandConfig loadHandConfig(const std::string& yaml_path);
+/// loadHandConfig of yaml text already read: `source` names it in messages, relative paths
+/// (hand.urdf, package_paths, sensor yamls) are resolved against `base_dir`.
+HandConfig parseHandConfig(const std::string& yaml_text, const std::string& source,
+                           const std::string& base_dir);
 
 /// Pose from [x, y, z, roll, pitch, yaw] (URDF's fixed-axis rpy: R = Rz(yaw) Ry(pitch) Rx(roll)).
 Eigen::Isometry3d poseFromXyzRpy(const std::vector<double>& xyz_rpy);

@@ -105,4 +105,10 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
 HandDescription loadHandDescription(const std::string& urdf_path, const PackagePaths& paths,
                                     const std::string& root_link = "");
 
+/// loadHandDescription of URDF text already read: `source` names it in messages (a file name),
+/// relative mesh file names are resolved against `base_dir`.
+HandDescription parseHandDescription(const std::string& urdf_xml, const std::string& source,
+                                     const std::string& base_dir, const PackagePaths& paths,
+                                     const std::string& root_link = "");
+
 }  // namespace norm2tex

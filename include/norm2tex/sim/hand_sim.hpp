@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -9,9 +10,12 @@
 
 #include "norm2tex/mesh/object_mesh.hpp"
 #include "norm2tex/gel/gel_law.hpp"
+#include "norm2tex/sim/gel_contact.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
 #include "norm2tex/sim/hand_config.hpp"
 #include "norm2tex/sim/hand_description.hpp"
+
+class btCollisionShape;
 
 namespace norm2tex {
 
@@ -56,13 +60,12 @@ struct SensorMountCheck {
 /// link's through Bullet's). A drive that pushes against its load stops where the load reaches
 /// its effort (one Newton step a tick, with the gels' law as the contact's stiffness), so a
 /// grasp's force is the drive's effort; a drive with stiffness k sits back from its position by
-/// load / k (as GripperSim's compliant drive). Mimic joints follow their master's position, and
-/// their load adds to the master's times the multiplier.
+/// load / k. Mimic joints follow their master's position, and their load adds to the master's
+/// times the multiplier. (GripperSim is the built-in parallel gripper on this class.)
 ///
 /// Each mounted DIGIT gets the package's compliant gel contact (gel law, friction anchors,
-/// patch torsion, too_deep) as GripperSim's two gels do, for any pose of its link; the DIGIT's
-/// own link meets the object only through its gel (its mesh includes the gel, which is soft);
-/// other links collide rigidly.
+/// patch torsion, too_deep), for any pose of its link; the DIGIT's own link meets the object
+/// only through its gel (its mesh includes the gel, which is soft); other links collide rigidly.
 ///
 /// Deterministic: the same config and commands give bit-identical trajectories.
 class HandSim {
@@ -72,6 +75,10 @@ class HandSim {
   /// link that is not in the hand, or a joint whose drive has no effort or velocity limit (in
   /// neither the URDF nor the hand yaml).
   explicit HandSim(const HandSimConfig& config);
+  /// The same with the hand given as `description` (loaded or made by the caller, as GripperSim
+  /// makes the built-in gripper's with the scene's stroke) instead of loaded from hand.urdf_path,
+  /// which then only names it in messages.
+  HandSim(const HandSimConfig& config, HandDescription description);
   ~HandSim();
   HandSim(const HandSim&) = delete;
   HandSim& operator=(const HandSim&) = delete;
@@ -86,6 +93,10 @@ class HandSim {
   /// Position of every joint of description().joints (fixed: 0).
   const std::vector<double>& jointPositions() const { return q_; }
   double jointPosition(const std::string& name) const;
+  /// Where each joint's drive has brought it (fixed and mimic joints: 0): its target approached
+  /// at the velocity limit, held back at the effort limit. A joint with a drive stiffness sits
+  /// back from it by load / stiffness.
+  const std::vector<double>& driveJointPositions() const { return drive_q_; }
   /// The generalised force the contacts exert on each joint (N or N m), after the last tick.
   const std::vector<double>& jointLoads() const { return load_; }
   /// The drive's effort and velocity limits and stiffness per joint (URDF or yaml).
@@ -118,9 +129,15 @@ class HandSim {
 
   /// Starts again: every joint, drive and target at its initial position (no trajectory), the
   /// root at hand.base_pose, the object at rest at `object_in_world` (config.object_pose when
-  /// null), the world rebuilt. Simulated time keeps running. Throws Error for a pose that is
-  /// not finite or not a rotation (nothing changed).
+  /// null), the world rebuilt. Simulated time keeps running; the object's collision stays as
+  /// construction made it. Throws Error for a pose that is not finite or not a rotation
+  /// (nothing changed).
   void reset(const Eigen::Isometry3d* object_in_world = nullptr);
+  /// As reset(), with the named actuated joints, their drives and their targets at `positions`
+  /// (clamped to their limits) instead of their initial positions. Throws Error (nothing
+  /// changed) as reset() and as setJointTargets for the names and positions.
+  void reset(const Eigen::Isometry3d& object_in_world, const std::vector<std::string>& joint_names,
+             const std::vector<double>& joint_positions);
   /// Puts the object at `object_in_world` at rest (with gravity on or off for it).
   void resetObject(const Eigen::Isometry3d& object_in_world, bool gravity = true);
   void setObjectGravity(bool on);
@@ -134,6 +151,9 @@ class HandSim {
   const SensorMount& sensor(int index) const { return config_.hand.sensors[index]; }
   const SensorMountCheck& sensorCheck(int index) const { return checks_[index]; }
   const GelContactState& contact(int sensor) const { return contacts_[sensor]; }
+  /// Whether the object reaches into the sensor's gel pad where it is now (contact() tells what
+  /// the last tick measured).
+  bool objectReachesIntoGel(int sensor) const;
   Eigen::Isometry3d linkInWorld(int link) const { return link_poses_[link]; }
   Eigen::Isometry3d gelInWorld(int sensor) const;
   /// The sensor's gel frame in its link frame.
@@ -158,7 +178,12 @@ class HandSim {
   };
 
   void resolveDrives();
+  /// The object's collision, once: resets rebuild the world but reuse its (stateless) shapes.
+  void makeCollision();
   void buildWorld();
+  /// reset()'s work, `joints` (indices) at `positions`, after the arguments were checked.
+  void restart(const Eigen::Isometry3d* object_in_world, const std::vector<int>& joints,
+               const std::vector<double>& positions);
   void checkMounts();
   std::vector<int> validateNames(const std::vector<std::string>& names) const;
   double clampToLimits(int joint, double value, bool& clamped) const;
@@ -200,6 +225,12 @@ class HandSim {
   ObjectMesh object_;
   Eigen::Isometry3d object_in_body_ = Eigen::Isometry3d::Identity();
   ObjectCollision collision_;
+  /// The object's Bullet shape (for the floor and its inertia) is back(); any shapes before it
+  /// are its convex parts. Declared before world_, whose bodies use them.
+  std::vector<std::unique_ptr<btCollisionShape>> object_shapes_;
+  /// What the gels touch, in the body frame: convex parts, or one capsule (a sphere: a == b).
+  std::vector<ConvexPolytope> contact_parts_;
+  std::optional<Capsule> contact_capsule_;
   std::unique_ptr<World> world_;
   std::vector<GelContactState> contacts_;
   std::int64_t ticks_ = 0;

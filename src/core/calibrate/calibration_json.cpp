@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <vector>
 
 #include "common/json_writer.hpp"
@@ -62,8 +63,14 @@ std::string calibrationReportJson(const CalibrationResult& result, double ball_d
   json.key("rim_shadow_sigma_mm").value(result.fit.shading.shadow_sigma_mm);
   json.key("held_out");
   writeSet(json, result.held_out_frames, result.held_out.variance_explained);
+  // A judged sensor (judgeSensor) was fitted on none of these presses: "fitted" is null.
+  json.key("judged").value(result.training_frames.empty());
   json.key("fitted");
-  writeSet(json, result.training_frames, result.fit.variance_explained);
+  if (result.training_frames.empty()) {
+    json.value(std::numeric_limits<double>::quiet_NaN());
+  } else {
+    writeSet(json, result.training_frames, result.fit.variance_explained);
+  }
   std::vector<PressFrameComparison> presses = result.held_out_frames;
   presses.insert(presses.end(), result.training_frames.begin(), result.training_frames.end());
   std::sort(presses.begin(), presses.end(),

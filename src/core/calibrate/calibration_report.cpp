@@ -45,11 +45,13 @@ std::string describeFrameMedians(const std::vector<PressFrameComparison>& frames
 
 std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
   const FitQuality& q = r.held_out;
-  return {
+  std::vector<std::string> lines = {
       format("scale %.4f mm/px (%.1f px/mm), rim shadow sigma %.2f mm", r.fit.geometry.mm_per_pixel,
              1.0 / r.fit.geometry.mm_per_pixel, r.fit.shading.shadow_sigma_mm),
-      format("fit on %.0f presses explains %.2f of their variance; %.0f held out:",
-             r.training_presses, r.fit.variance_explained, q.presses),
+      r.training_presses > 0
+          ? format("fit on %.0f presses explains %.2f of their variance; %.0f held out:",
+                   r.training_presses, r.fit.variance_explained, q.presses)
+          : format("nothing fitted (judged); %.0f presses held out:", q.presses),
       format("  variance explained %.2f", q.variance_explained),
       format("  contact mean |diff| real %.1f sim %.1f; 95th pct real %.1f sim %.1f",
              q.real_contact_mean, q.sim_contact_mean, q.real_contact_p95, q.sim_contact_p95),
@@ -61,9 +63,12 @@ std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
       "  " + describeFrameMedians(r.held_out_frames, &PressFrameComparison::similarity),
       "  bare background " +
           describeFrameMedians(r.held_out_frames, &PressFrameComparison::bare_background),
-      "fitted presses' " +
-          describeFrameMedians(r.training_frames, &PressFrameComparison::similarity),
   };
+  if (!r.training_frames.empty()) {
+    lines.push_back("fitted presses' " +
+                    describeFrameMedians(r.training_frames, &PressFrameComparison::similarity));
+  }
+  return lines;
 }
 
 std::vector<std::string> describeScaleSearch(const ShadingFit& fit) {

@@ -90,16 +90,19 @@ PressFrameComparison compareFrames(const PressObservation& press, const cv::Mat3
   return comparison;
 }
 
-}  // namespace
 
-CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
-                                  const CalibrationOptions& options) {
+// What calibrating and judging check first (`min_presses` differs).
+void checkInput(const SensorModel& base, const CalibrationInput& input, int min_presses,
+                const char* what) {
   validate(base);
-  if (input.backgrounds.empty()) throw Error("calibration needs at least one background frame");
-  if (static_cast<int>(input.presses.size()) < kMinCalibrationPresses) {
-    throw Error("calibration needs at least " + std::to_string(kMinCalibrationPresses) +
-                " ball presses (3 to fit, 1 to hold out); got " +
-                std::to_string(input.presses.size()));
+  if (input.backgrounds.empty()) {
+    throw Error(std::string(what) + " needs at least one background frame");
+  }
+  if (static_cast<int>(input.presses.size()) < min_presses) {
+    throw Error(std::string(what) + " needs at least " + std::to_string(min_presses) +
+                " ball press" + (min_presses > 1 ? "es" : "") +
+                (min_presses == kMinCalibrationPresses ? " (3 to fit, 1 to hold out)" : "") +
+                "; got " + std::to_string(input.presses.size()));
   }
   if (!(input.ball_diameter_mm > 0.0 && input.ball_diameter_mm <= 100.0)) {
     std::ostringstream message;
@@ -111,81 +114,52 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
     throw Error("labels: " + std::to_string(input.labels.size()) + " given for " +
                 std::to_string(input.presses.size()) + " presses; give one per press or none");
   }
-  if (!(options.holdout_fraction > 0.0 && options.holdout_fraction < 1.0)) {
-    throw Error("holdout fraction must be in (0, 1)");
-  }
   for (const NamedFrame& frame : input.backgrounds) checkFrame(base, frame, "background");
   for (const NamedFrame& frame : input.presses) checkFrame(base, frame, "press");
+}
 
-  CalibrationResult result;
-  const cv::Mat3f background = meanBackground(input.backgrounds);
-  background.convertTo(result.background, CV_8U);
+// Press i's observation: its difference to the mean background, its circle (labelled or
+// detected), its lighting drift removed. Marks it in `labelled` when its circle was given.
+PressObservation observePress(const CalibrationInput& input, int i, const cv::Mat3f& background,
+                              std::set<std::string>& labelled) {
+  PressObservation press;
+  press.name = input.presses[i].name;
+  input.presses[i].image.convertTo(press.diff, CV_32F);
+  press.diff -= background;
+  const bool has_label = !input.labels.empty() && input.labels[i];
+  press.circle = has_label ? *input.labels[i] : detectPress(press.diff, press.name);
+  if (has_label) labelled.insert(press.name);
+  removeDrift(press);
+  return press;
+}
 
-  // Contact circles and drift-corrected differences.
-  std::vector<PressObservation> training, held_out;
-  std::vector<int> training_index, held_out_index;  // each press's place in the input
-  std::set<std::string> labelled;  // presses whose circle the user gave: never refined
-  const int n = static_cast<int>(input.presses.size());
-  const int held_out_count =
-      std::clamp(static_cast<int>(std::lround(options.holdout_fraction * n)), 1, n - 3);
-  for (int i = 0; i < n; ++i) {
-    PressObservation press;
-    press.name = input.presses[i].name;
-    input.presses[i].image.convertTo(press.diff, CV_32F);
-    press.diff -= background;
-    const bool has_label = !input.labels.empty() && input.labels[i];
-    press.circle = has_label ? *input.labels[i] : detectPress(press.diff, press.name);
-    if (has_label) labelled.insert(press.name);
-    removeDrift(press);
-    // Spread the held-out presses evenly over the set: press i is held out when the running
-    // count floor((i + 1) k / n) steps up.
-    const bool hold = (i + 1) * held_out_count / n > i * held_out_count / n;
-    (hold ? held_out : training).push_back(std::move(press));
-    (hold ? held_out_index : training_index).push_back(i);
-  }
-
-  const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
-  // A first fit on the detected circles, then every press's circle refined against it (labelled
-  // ones are kept), then the final fit.
-  const ShadingFit first =
-      fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
-  {
-    SensorModel model = base;
-    model.mm_per_pixel = first.geometry.mm_per_pixel;
-    model.shading = first.shading;
-    const DigitShader shader(model, cv::Mat3b(base.imageSize(), cv::Vec3b(0, 0, 0)),
-                             BackgroundSource::kCaptured);
-    for (std::vector<PressObservation>* set : {&training, &held_out}) {
-      for (PressObservation& press : *set) {
-        if (labelled.count(press.name)) continue;
-        PressCircle start = press.circle;
-        start.radius_px *= first.geometry.radius_factor;
-        press.circle = refinePressCircle(shader, model, press, start, ball_radius_mm);
-      }
+// Every unlabelled press's circle refined against `model` (geometry only), each starting from
+// its circle times `radius_factor`.
+void refineCircles(const SensorModel& model, double radius_factor, double ball_radius_mm,
+                   const std::set<std::string>& labelled,
+                   std::initializer_list<std::vector<PressObservation>*> sets) {
+  const DigitShader shader(model, cv::Mat3b(model.imageSize(), cv::Vec3b(0, 0, 0)),
+                           BackgroundSource::kCaptured);
+  for (std::vector<PressObservation>* set : sets) {
+    for (PressObservation& press : *set) {
+      if (labelled.count(press.name)) continue;
+      PressCircle start = press.circle;
+      start.radius_px *= radius_factor;
+      press.circle = refinePressCircle(shader, model, press, start, ball_radius_mm);
     }
   }
-  // The refined circles carry the first radius factor: the refit starts from factor 1.
-  result.fit = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel,
-                                     PressGeometry{first.geometry.mm_per_pixel, 1.0});
-  // The scale profile is the first fit's, on the detected circles: the refined ones were fitted
-  // at the first scale and would favour it.
-  result.fit.scale_search = first.scale_search;
-  result.training_presses = static_cast<int>(training.size());
+}
 
-  result.model = base;
-  result.model.mm_per_pixel = result.fit.geometry.mm_per_pixel;
-  result.model.gel = result.fit.gel;
-  result.model.shading = result.fit.shading;
-  result.model.noise = measureBackgroundNoise([&] {
-    std::vector<cv::Mat3b> frames;
-    for (const NamedFrame& frame : input.backgrounds) frames.push_back(frame.image);
-    return frames;
-  }());
-  result.model.background_image.clear();
-
-  // Every press rendered by the shader itself at the fitted geometry: the held-out ones judge
-  // the fit; the fitted ones' frames are compared too (one render each, cheap beside the fit).
-  // Presses on all cores, each into its own slot (DigitShader keeps per-thread scratch).
+// Every press rendered by the shader itself at result.model and result.fit.geometry: the
+// held-out ones judge the model (held_out, its simulated differences and radii); every press's
+// frame is compared with its real one. Presses on all cores, each into its own slot
+// (DigitShader keeps per-thread scratch).
+void renderAndCompare(const CalibrationInput& input, std::vector<PressObservation> held_out,
+                      const std::vector<PressObservation>& training,
+                      const std::vector<int>& held_out_index,
+                      const std::vector<int>& training_index,
+                      const std::set<std::string>& labelled, double ball_radius_mm,
+                      CalibrationResult& result) {
   const DigitShader shader(result.model, result.background, BackgroundSource::kCaptured);
   const int held_out_jobs = static_cast<int>(held_out.size());
   const int press_count = held_out_jobs + static_cast<int>(training.size());
@@ -225,6 +199,105 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   result.held_out_presses = std::move(held_out);
   result.held_out =
       compareWithReal(result.held_out_presses, result.held_out_simulated, result.held_out_radii_px);
+}
+
+}  // namespace
+
+CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
+                                  const CalibrationOptions& options) {
+  checkInput(base, input, kMinCalibrationPresses, "calibration");
+  if (!(options.holdout_fraction > 0.0 && options.holdout_fraction < 1.0)) {
+    throw Error("holdout fraction must be in (0, 1)");
+  }
+
+  CalibrationResult result;
+  const cv::Mat3f background = meanBackground(input.backgrounds);
+  background.convertTo(result.background, CV_8U);
+
+  // Contact circles and drift-corrected differences.
+  std::vector<PressObservation> training, held_out;
+  std::vector<int> training_index, held_out_index;  // each press's place in the input
+  std::set<std::string> labelled;  // presses whose circle the user gave: never refined
+  const int n = static_cast<int>(input.presses.size());
+  const int held_out_count =
+      std::clamp(static_cast<int>(std::lround(options.holdout_fraction * n)), 1, n - 3);
+  for (int i = 0; i < n; ++i) {
+    PressObservation press = observePress(input, i, background, labelled);
+    // Spread the held-out presses evenly over the set: press i is held out when the running
+    // count floor((i + 1) k / n) steps up.
+    const bool hold = (i + 1) * held_out_count / n > i * held_out_count / n;
+    (hold ? held_out : training).push_back(std::move(press));
+    (hold ? held_out_index : training_index).push_back(i);
+  }
+
+  const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
+  // A first fit on the detected circles, then every press's circle refined against it (labelled
+  // ones are kept), then the final fit.
+  const ShadingFit first =
+      fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel);
+  {
+    SensorModel model = base;
+    model.mm_per_pixel = first.geometry.mm_per_pixel;
+    model.shading = first.shading;
+    refineCircles(model, first.geometry.radius_factor, ball_radius_mm, labelled,
+                  {&training, &held_out});
+  }
+  // The refined circles carry the first radius factor: the refit starts from factor 1.
+  result.fit = fitShadingAndGeometry(base, training, ball_radius_mm, input.mm_per_pixel,
+                                     PressGeometry{first.geometry.mm_per_pixel, 1.0});
+  // The scale profile is the first fit's, on the detected circles: the refined ones were fitted
+  // at the first scale and would favour it.
+  result.fit.scale_search = first.scale_search;
+  result.training_presses = static_cast<int>(training.size());
+
+  result.model = base;
+  result.model.mm_per_pixel = result.fit.geometry.mm_per_pixel;
+  result.model.gel = result.fit.gel;
+  result.model.shading = result.fit.shading;
+  result.model.noise = measureBackgroundNoise([&] {
+    std::vector<cv::Mat3b> frames;
+    for (const NamedFrame& frame : input.backgrounds) frames.push_back(frame.image);
+    return frames;
+  }());
+  result.model.background_image.clear();
+
+  // Every press rendered at the fitted geometry: the held-out ones judge the fit; the fitted
+  // ones' frames are compared too (one render each, cheap beside the fit).
+  renderAndCompare(input, std::move(held_out), training, held_out_index, training_index, labelled,
+                   ball_radius_mm, result);
+  return result;
+}
+
+CalibrationResult judgeSensor(const SensorModel& fitted, const CalibrationInput& input) {
+  checkInput(fitted, input, 1, "judging a sensor");
+  if (input.mm_per_pixel && std::abs(*input.mm_per_pixel - fitted.mm_per_pixel) >
+                                1e-9 * fitted.mm_per_pixel) {
+    std::ostringstream message;
+    message << "the sensor judged was calibrated at " << fitted.mm_per_pixel
+            << " mm/px, not the " << *input.mm_per_pixel << " given: leave the scale out";
+    throw Error(message.str());
+  }
+  CalibrationResult result;
+  const cv::Mat3f background = meanBackground(input.backgrounds);
+  background.convertTo(result.background, CV_8U);
+  std::vector<PressObservation> presses;
+  std::vector<int> index;
+  std::set<std::string> labelled;
+  for (int i = 0; i < static_cast<int>(input.presses.size()); ++i) {
+    presses.push_back(observePress(input, i, background, labelled));
+    index.push_back(i);
+  }
+  const double ball_radius_mm = 0.5 * input.ball_diameter_mm;
+  // The circles found as the calibration finds its held-out presses': refined against the
+  // model (geometry only); nothing of the shading is fitted to these presses.
+  refineCircles(fitted, 1.0, ball_radius_mm, labelled, {&presses});
+  result.model = fitted;
+  result.model.background_image.clear();
+  result.fit.geometry = PressGeometry{fitted.mm_per_pixel, 1.0};
+  result.fit.shading = fitted.shading;
+  result.fit.gel = fitted.gel;
+  result.training_presses = 0;
+  renderAndCompare(input, std::move(presses), {}, index, {}, labelled, ball_radius_mm, result);
   return result;
 }
 

@@ -5,13 +5,12 @@
 #include <limits>
 #include <random>
 #include <sstream>
-
-#include <btBulletDynamicsCommon.h>
+#include <string>
+#include <vector>
 
 #include "norm2tex/common/error.hpp"
-#include "sim/bullet_eigen.hpp"
-#include "sim/gel_pad_contacts.hpp"
-#include "sim/object_collision.hpp"
+#include "norm2tex/sim/hand_sim.hpp"
+#include "sim/parallel_gripper_files.hpp"
 
 namespace norm2tex {
 namespace {
@@ -23,41 +22,86 @@ constexpr double kGraspHoldS = 0.1;
 // An object's side must overlap the gel pads by this much (height) at a height offset reset()
 // accepts.
 constexpr double kMinPadOverlap = 1e-3;
-// Collision filter groups: the gels never collide through Bullet (the package makes their
-// contacts), the object still meets the floor.
-constexpr int kGelGroup = 1 << 6;
-constexpr int kObjectGroup = 1 << 7;
+// The built-in hand (config/hands/parallel_gripper.urdf): the left finger's joint is the
+// drive's, the right finger's mimics it; its sensors are the left gel's, then the right's.
+const char* const kFingerJoint = "finger_left_joint";
+const char* const kMimicJoint = "finger_right_joint";
+const char* const kBuiltInUrdf = "config/hands/parallel_gripper.urdf (built in)";
+const char* const kBuiltInYaml = "config/hands/parallel_gripper.yaml (built in)";
 
 // Uniform in [0, 1) from a 64-bit engine, the same on every platform
 // (std::uniform_real_distribution is not specified bit for bit).
 double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
-}  // namespace
-
-struct GripperSim::World {
-  btDefaultCollisionConfiguration collision_config;
-  btCollisionDispatcher dispatcher{&collision_config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world{&dispatcher, &broadphase, &solver, &collision_config};
-
-  std::unique_ptr<btCollisionShape> floor_shape;
-  std::unique_ptr<btRigidBody> floor;
-  std::unique_ptr<GelPadContacts> gels;  ///< the left gel's is pad 0, the right's pad 1
-  std::unique_ptr<btRigidBody> object;
-
-  ~World() {
-    gels.reset();  // its manifolds name the object
-    if (object) world.removeRigidBody(object.get());
-    if (floor) world.removeRigidBody(floor.get());
+// The built-in hand's URDF with the scene's stroke: each finger's joint (its gel surface's
+// distance from the centre plane) between half the closed and half the open gap.
+HandDescription builtInHandDescription(const GripperOptions& gripper) {
+  // No meshes to find: the gels are the hand's only geometry.
+  PackagePaths no_packages;
+  no_packages.use_ros_package_path = false;
+  HandDescription description =
+      parseHandDescription(detail::kParallelGripperUrdf, kBuiltInUrdf, ".", no_packages);
+  for (const char* name : {kFingerJoint, kMimicJoint}) {
+    const int j = description.jointIndex(name);
+    if (j < 0) {
+      throw Error(std::string(kBuiltInUrdf) + " has no joint '" + name +
+                  "' (a bug: please report it)");
+    }
+    description.joints[j].lower = gripper.min_gap_m / 2.0;
+    description.joints[j].upper = gripper.max_gap_m / 2.0;
   }
-};
+  return description;
+}
+
+// The built-in hand holding the scene's object, with the scene's gripper, physics and gels.
+HandSimConfig builtInHand(const GripperSimConfig& scene) {
+  const GripperOptions& g = scene.gripper;
+  HandSimConfig config;
+  config.hand = parseHandConfig(detail::kParallelGripperYaml, kBuiltInYaml, ".");
+  config.hand.urdf_path = kBuiltInUrdf;  // given as a description: its name in messages
+  // The yaml mounts each DIGIT square on its finger, a quarter turn about z, which double
+  // precision rounds (cos(pi / 2) = 6e-17): the gels face exactly along the grip axis with the
+  // exact rotation (GripperSim::gelInFinger). A gripper on the same trajectory as before it ran
+  // on HandSim, bit for bit (as long as its drive stays below its force limit).
+  for (const Finger finger : {Finger::kLeft, Finger::kRight}) {
+    SensorMount& mount = config.hand.sensors.at(static_cast<int>(finger));
+    const Eigen::Isometry3d square = GripperSim::gelInFinger(finger) * gelInDigit().inverse();
+    if (!mount.digit_in_link.isApprox(square, 1e-12)) {
+      throw Error(std::string(kBuiltInYaml) + ": sensor '" + mount.name +
+                  "' is not mounted as the built-in gripper's gel (a bug: please report it)");
+    }
+    mount.digit_in_link = square;
+  }
+  config.hand.base_pose = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, g.base_height_m));
+  // One drive moves both fingers (a servo through a rack or linkage): the mimic finger's load
+  // adds to its own, so the scene's force per gel is half its effort, and its stiffness per
+  // finger (a finger sits back by its gel's force / k) is half the drive's (which sits back by
+  // the sum of both / its stiffness).
+  JointDriveOptions& drive = config.hand.drives[kFingerJoint];
+  drive.effort = 2.0 * g.max_force_n;
+  drive.velocity = g.max_speed_m_s;
+  drive.stiffness = 2.0 * g.stiffness_n_per_m;
+  config.hand.initial_positions = {{kFingerJoint, g.max_gap_m / 2.0}};
+  config.hand.gripper_joints = {kFingerJoint};
+  config.hand.gripper_closed = {g.min_gap_m / 2.0};
+  config.hand.gripper_open = {g.max_gap_m / 2.0};
+  config.object = scene.object;
+  // Where the constructor seats it once the mesh (loaded by HandSim) tells its centre.
+  config.object_pose = config.hand.base_pose;
+  config.physics = scene.physics;
+  config.gel_law = scene.gel_law;
+  config.gel_width_m = scene.gel_width_m;
+  config.gel_height_m = scene.gel_height_m;
+  config.gel_thickness_m = scene.gel_thickness_m;
+  return config;
+}
+
+}  // namespace
 
 GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   validate(config_);
-  object_ = loadObjectMesh(config_.object.mesh, config_.object.scale);
-  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
-  object_in_body_ = Eigen::Translation3d(-centre);
+  hand_ = std::make_unique<HandSim>(builtInHand(config_), builtInHandDescription(config_.gripper));
+  finger_joint_ = hand_->description().jointIndex(kFingerJoint);
   if (objectWidthM() + 2 * kSeatClearance > config_.gripper.max_gap_m) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
@@ -81,41 +125,30 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
     }
     throw Error(message.str());
   }
-  // Built once: resets rebuild the world but reuse the (stateless) shapes.
-  makeCollision(centre);
-  findHeightOffsetRange(centre);
-  command_ = 1.0;
-  finger_position_m_ = config_.gripper.max_gap_m / 2.0;
-  drive_position_m_ = finger_position_m_;
-  buildWorld(height_offset_range_.first);
+  findHeightOffsetRange();
+  // The object at the lowest offset, the fingers open.
+  hand_->reset(seatedObjectPose(height_offset_range_.first), {kFingerJoint},
+               {config_.gripper.max_gap_m / 2.0});
+  command(1.0);
 }
 
 GripperSim::~GripperSim() = default;
 
-void GripperSim::makeCollision(const Eigen::Vector3d& centre) {
-  // The object starts unrotated: the gels face its world +-y sides.
-  ObjectCollisionShapes shapes =
-      makeObjectCollision(object_, config_.object.collision, centre,
-                          config_.gel_law.points().back().first, Eigen::Vector3d::UnitY());
-  object_shapes_ = std::move(shapes.shapes);
-  contact_parts_ = std::move(shapes.contact_parts);
-  contact_capsule_ = shapes.contact_capsule;
-  collision_ = shapes.collision;
-}
-
-void GripperSim::findHeightOffsetRange(const Eigen::Vector3d& centre) {
+void GripperSim::findHeightOffsetRange() {
   // The gels meet the object within their reach (the law's deepest point) of its extent along
   // the grip axis: both sides' bands must overlap the pads' height, or no grasp can be made.
   const EpisodeOptions& e = config_.episode;
   const double reach = config_.gel_law.points().back().first;
   const double pad = config_.gel_height_m / 2;
-  const Eigen::AlignedBox3d bounds = object_.mesh.bounds().cast<double>();
+  const ObjectMesh& object = hand_->object();
+  const Eigen::AlignedBox3d bounds = object.mesh.bounds().cast<double>();
+  const Eigen::Vector3d centre = object.mesh.bounds().center().cast<double>();
   double low = e.height_offset_low_m, high = e.height_offset_high_m;
   std::ostringstream sides;
   for (double side : {1.0, -1.0}) {
     const double extreme = side > 0 ? bounds.max().y() : bounds.min().y();
     double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
-    for (const Eigen::Vector3f& v : object_.mesh.vertices()) {
+    for (const Eigen::Vector3f& v : object.mesh.vertices()) {
       if (side * (extreme - v.y()) <= reach) {
         z_lo = std::min(z_lo, v.z() - centre.z());
         z_hi = std::max(z_hi, v.z() - centre.z());
@@ -141,14 +174,6 @@ void GripperSim::findHeightOffsetRange(const Eigen::Vector3d& centre) {
   height_offset_range_ = {low, high};
 }
 
-double GripperSim::objectMinHalfSizeM() const {
-  return static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0;
-}
-
-double GripperSim::objectWidthM() const {
-  return static_cast<double>(object_.mesh.bounds().sizes().y());
-}
-
 double GripperSim::drivePreload(double depth) const {
   const double k = config_.gripper.stiffness_n_per_m;
   return k > 0.0 ? config_.gel_law.force(depth) / k : 0.0;
@@ -161,8 +186,10 @@ double GripperSim::gapForOpening(double opening) const {
 
 double GripperSim::opening() const {
   const GripperOptions& g = config_.gripper;
-  return (2.0 * finger_position_m_ - g.min_gap_m) / (g.max_gap_m - g.min_gap_m);
+  return (2.0 * fingerPosition() - g.min_gap_m) / (g.max_gap_m - g.min_gap_m);
 }
+
+double GripperSim::fingerPosition() const { return hand_->jointPositions()[finger_joint_]; }
 
 void GripperSim::setOpening(double opening) {
   if (!(opening >= 0.0 && opening <= 1.0)) {
@@ -170,7 +197,7 @@ void GripperSim::setOpening(double opening) {
     message << "gripper opening " << opening << " is out of range; valid: [0, 1] (0 = closed)";
     throw Error(message.str());
   }
-  command_ = opening;
+  command(opening);
 }
 
 void GripperSim::addOpening(double delta) {
@@ -179,7 +206,14 @@ void GripperSim::addOpening(double delta) {
     message << "gripper opening delta " << delta << " is out of range; valid: [-1, 1]";
     throw Error(message.str());
   }
-  command_ = std::clamp(command_ + delta, 0.0, 1.0);
+  command(std::clamp(command_ + delta, 0.0, 1.0));
+}
+
+void GripperSim::command(double opening) {
+  command_ = opening;
+  // Target positions outside the joint's limits are clamped: gapForOpening(1) / 2 may round a
+  // hair above max_gap / 2.
+  hand_->setJointTargets({kFingerJoint}, {gapForOpening(opening) / 2.0});
 }
 
 Eigen::Isometry3d GripperSim::baseInWorld() const {
@@ -188,7 +222,7 @@ Eigen::Isometry3d GripperSim::baseInWorld() const {
 
 Eigen::Isometry3d GripperSim::fingerInBase(Finger finger) const {
   const double side = finger == Finger::kLeft ? 1.0 : -1.0;
-  return Eigen::Isometry3d(Eigen::Translation3d(0.0, side * finger_position_m_, 0.0));
+  return Eigen::Isometry3d(Eigen::Translation3d(0.0, side * fingerPosition(), 0.0));
 }
 
 Eigen::Isometry3d GripperSim::gelInFinger(Finger finger) {
@@ -209,127 +243,46 @@ Eigen::Isometry3d GripperSim::gelInFinger(Finger finger) {
 }
 
 Eigen::Isometry3d GripperSim::gelInWorld(Finger finger) const {
-  return baseInWorld() * fingerInBase(finger) * gelInFinger(finger);
+  // The hand's: its link's pose, then the DIGIT's mount in parallel_gripper.yaml (its rotation
+  // is gelInFinger's to within 1e-16, the sine of a right angle in double precision).
+  return hand_->gelInWorld(static_cast<int>(finger));
 }
 
-Eigen::Isometry3d GripperSim::objectInWorld() const {
-  return toEigen(world_->object->getWorldTransform()) * object_in_body_;
+Eigen::Isometry3d GripperSim::objectInWorld() const { return hand_->objectInWorld(); }
+
+const GelContactState& GripperSim::contact(Finger finger) const {
+  return hand_->contact(static_cast<int>(finger));
 }
 
-void GripperSim::buildWorld(double object_height_m) {
-  world_ = std::make_unique<World>();
-  btDiscreteDynamicsWorld& w = world_->world;
-  const PhysicsOptions& p = config_.physics;
-  w.setGravity(btVector3(0, 0, -p.gravity_m_s2));
-  btContactSolverInfo& solver = w.getSolverInfo();
-  solver.m_numIterations = p.solver_iterations;
-  solver.m_frictionERP = p.friction_erp;
-  // Bullet's residual is the largest squared velocity correction (m/s) of an iteration: stop
-  // once the contacts have converged instead of always running every iteration (a held object
-  // converges in a few; 3-4x fewer per tick, the same grasp).
-  solver.m_leastSquaresResidualThreshold =
-      static_cast<btScalar>(p.solver_tolerance_m_s * p.solver_tolerance_m_s);
-  // Two friction directions per contact: a held object resists slip along the gel in 2-D.
-  solver.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+std::int64_t GripperSim::ticks() const { return hand_->ticks(); }
 
-  // Floor: where a dropped object ends up.
-  world_->floor_shape = std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
-  world_->floor = std::make_unique<btRigidBody>(
-      btRigidBody::btRigidBodyConstructionInfo(0, nullptr, world_->floor_shape.get()));
-  world_->floor->setFriction(0.5);
-  w.addRigidBody(world_->floor.get(), btBroadphaseProxy::StaticFilter,
-                 btBroadphaseProxy::AllFilter & ~kGelGroup);
+const ObjectMesh& GripperSim::object() const { return hand_->object(); }
 
-  // Gels: the package's compliant contact with the material's friction (Bullet multiplies the
-  // two bodies' coefficients; the object's is 1).
-  const GelPadOptions pads = gelPadOptionsOf(config_, objectMinHalfSizeM());
-  world_->gels = std::make_unique<GelPadContacts>(w, world_->dispatcher, 2, pads, kGelGroup);
+const ObjectCollision& GripperSim::collision() const { return hand_->collision(); }
 
-  // Object: dynamic, its body at its bounds' centre.
-  btCollisionShape* shape = object_shapes_.back().get();
-  btVector3 inertia(0, 0, 0);
-  shape->calculateLocalInertia(config_.object.mass_kg, inertia);
-  btRigidBody::btRigidBodyConstructionInfo info(config_.object.mass_kg, nullptr, shape, inertia);
-  info.m_friction = 1.0;
-  info.m_restitution = 0;
-  world_->object = std::make_unique<btRigidBody>(info);
-  world_->object->setActivationState(DISABLE_DEACTIVATION);
-  world_->object->setCollisionFlags(world_->object->getCollisionFlags() |
-                                    btCollisionObject::CF_HAS_FRICTION_ANCHOR);
-  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
-  body.translation() = Eigen::Vector3d(0, 0, config_.gripper.base_height_m + object_height_m);
-  world_->object->setWorldTransform(toBt(body));
-  w.addRigidBody(world_->object.get(), kObjectGroup, btBroadphaseProxy::StaticFilter);
-  // The gel contacts live in the package's own manifolds, which the solver takes like any other.
-  world_->gels->attach(*world_->object, GelContactGeometry{&contact_parts_, &contact_capsule_});
-
-  moveFingers(0.0);
-  contacts_.assign(2, GelContactState{});
-  for (int i = 0; i < 2; ++i) {
-    contacts_[i].object_in_gel = gelInWorld(static_cast<Finger>(i)).inverse() * objectInWorld();
-  }
+double GripperSim::objectWidthM() const {
+  return static_cast<double>(hand_->object().mesh.bounds().sizes().y());
 }
 
-void GripperSim::moveFingers(double dt) {
-  // The drive: coupled, speed-limited position control; the force limit stops closing (never
-  // opening).
-  const double target = gapForOpening(command_) / 2.0;
-  const double max_move = config_.gripper.max_speed_m_s * dt;
-  double next = drive_position_m_ + std::clamp(target - drive_position_m_, -max_move, max_move);
-  const double force = std::max(contacts_[0].normal_force_n, contacts_[1].normal_force_n);
-  if (next < drive_position_m_ && force >= config_.gripper.max_force_n) next = drive_position_m_;
-  drive_position_m_ = next;
-  finger_position_m_ = config_.gripper.stiffness_n_per_m > 0.0 ? compliantFingerPosition(max_move)
-                                                               : drive_position_m_;
-  for (int i = 0; i < 2; ++i) world_->gels->place(i, gelInWorld(static_cast<Finger>(i)));
-}
-
-double GripperSim::compliantFingerPosition(double max_move) const {
-  // Each finger is a spring of stiffness k in series with its gel: at rest it sits at
-  // x = drive + F(x) / k, F the gel's force at finger position x. The gel is 4-15 times
-  // stiffer than a 1 N/mm drive (its law's slope is 4 N/mm at first touch, 15 N/mm at 0.5 mm),
-  // so x <- drive + F / k per tick would overshoot by that factor: it diverges until the speed
-  // limit catches it, then rings there (0.2 N and 20 um on a held cube). One Newton step
-  // of x - drive - F(x) / k = 0 per tick instead, with dF/dx = -k_gel the law's tangent at the
-  // indentation that carries F (both gels are pressed deeper when the fingers close, the
-  // object between them staying put): the residual shrinks every tick by the error in k_gel
-  // alone, however stiff the gel. Out of contact k_gel = 0 and the finger is where the drive
-  // is. One drive moves both fingers (a servo through a rack or linkage), so both sit back by
-  // the mean of the two forces: at rest the object's balance along the grip axis makes them
-  // equal, in motion the mean is what the drive carries.
-  const double k = config_.gripper.stiffness_n_per_m;
-  const double force = 0.5 * (contacts_[0].normal_force_n + contacts_[1].normal_force_n);
-  const double k_gel =
-      force > 0.0 ? config_.gel_law.tangentStiffness(config_.gel_law.indentation(force)) : 0.0;
-  const double residual = drive_position_m_ + force / k - finger_position_m_;
-  return finger_position_m_ + std::clamp(residual * k / (k + k_gel), -max_move, max_move);
-}
-
-void GripperSim::measureContacts(double dt) {
-  const Eigen::Isometry3d object_in_world = objectInWorld();
-  world_->gels->measure(dt, object_in_world, contacts_);
-  // Dropped: free of both gels and below their lower edge.
-  const double lower_edge = config_.gripper.base_height_m - config_.gel_height_m / 2.0;
-  if (!contacts_[0].in_contact && !contacts_[1].in_contact &&
-      object_in_world.translation().z() < lower_edge) {
-    dropped_ = true;
-  }
+Eigen::Isometry3d GripperSim::seatedObjectPose(double offset_m) const {
+  const Eigen::Vector3d centre = hand_->object().mesh.bounds().center().cast<double>();
+  const Eigen::Isometry3d body(
+      Eigen::Translation3d(0.0, 0.0, config_.gripper.base_height_m + offset_m));
+  return body * Eigen::Translation3d(-centre);
 }
 
 void GripperSim::step(int ticks) {
-  const int substeps = config_.physics.substeps;
-  const double dt = tickSeconds() / substeps;
+  // Dropped: free of both gels and below their lower edge, at the end of a tick.
+  const double lower_edge = config_.gripper.base_height_m - config_.gel_height_m / 2.0;
   for (int t = 0; t < ticks; ++t) {
-    for (int s = 0; s < substeps; ++s) {
-      moveFingers(dt);
-      world_->gels->updateContacts();
-      world_->gels->updateStiffness();
-      world_->world.stepSimulation(dt, 0, dt);
-      measureContacts(dt);
+    hand_->step(1);
+    if (!contact(Finger::kLeft).in_contact && !contact(Finger::kRight).in_contact &&
+        objectInWorld().translation().z() < lower_edge) {
+      dropped_ = true;
     }
-    ++ticks_;
   }
 }
+
 
 double GripperSim::closeOnTheObject(double offset_m) {
   const EpisodeOptions& e = config_.episode;
@@ -338,11 +291,12 @@ double GripperSim::closeOnTheObject(double offset_m) {
     return std::clamp((gap - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0, 1.0);
   };
   const auto ticksToArrive = [&] {
-    const double travel = std::abs(drive_position_m_ - gapForOpening(command_) / 2.0);
+    const double travel =
+        std::abs(hand_->driveJointPositions()[finger_joint_] - gapForOpening(command_) / 2.0);
     return static_cast<int>(std::ceil(travel / g.max_speed_m_s / tickSeconds()));
   };
   if (e.grasp_opening >= 0.0) {
-    command_ = e.grasp_opening;
+    command(e.grasp_opening);
     step(ticksToArrive());
     return command_;
   }
@@ -350,9 +304,11 @@ double GripperSim::closeOnTheObject(double offset_m) {
   // narrower than its width minus the gel law's deepest point on each side never will: its
   // sides miss the pads at this height.
   const double deepest_law_point = config_.gel_law.points().back().first;
-  command_ = openingForGap(objectWidthM() - 2 * deepest_law_point);
+  command(openingForGap(objectWidthM() - 2 * deepest_law_point));
   const int limit = ticksToArrive() + 1;
-  for (int t = 0; !(contacts_[0].in_contact && contacts_[1].in_contact); ++t) {
+  const GelContactState& left = contact(Finger::kLeft);
+  const GelContactState& right = contact(Finger::kRight);
+  for (int t = 0; !(left.in_contact && right.in_contact); ++t) {
     if (t > limit) {
       std::ostringstream message;
       message << "the object does not reach both gel pads at height offset " << offset_m * 1e3
@@ -367,10 +323,9 @@ double GripperSim::closeOnTheObject(double offset_m) {
   // plus what each gel is already indented.
   const double depth =
       e.grasp_force_n > 0.0 ? config_.gel_law.indentation(e.grasp_force_n) : e.grasp_indentation_m;
-  const double width =
-      2.0 * finger_position_m_ + contacts_[0].penetration_m + contacts_[1].penetration_m;
+  const double width = 2.0 * fingerPosition() + left.penetration_m + right.penetration_m;
   // A compliant drive must go further by the deflection the grip's force causes.
-  command_ = openingForGap(width - 2.0 * (depth + drivePreload(depth)));
+  command(openingForGap(width - 2.0 * (depth + drivePreload(depth))));
   step(ticksToArrive());
   return command_;
 }
@@ -404,20 +359,18 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
   // kSeatClearance wider than it on each side, without gravity on it.
   dropped_ = false;
   const auto seat = [&] {
-    command_ = std::clamp(
+    const double opening = std::clamp(
         (objectWidthM() + 2 * kSeatClearance - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0,
         1.0);
-    finger_position_m_ = gapForOpening(command_) / 2.0;
-    drive_position_m_ = finger_position_m_;
-    buildWorld(offset);
+    hand_->reset(seatedObjectPose(offset), {kFingerJoint}, {gapForOpening(opening) / 2.0});
+    command(opening);
   };
   seat();
   for (int i = 0; i < 2; ++i) {
-    for (const auto& part : world_->gels->objectPointsIn(i)) {
-      if (!part.empty()) throw Error("the seated object overlaps a gel (a bug: please report it)");
-    }
+    if (hand_->objectReachesIntoGel(i))
+      throw Error("the seated object overlaps a gel (a bug: please report it)");
   }
-  world_->object->setGravity(btVector3(0, 0, 0));
+  hand_->setObjectGravity(false);
   try {
     start.grasp_opening = closeOnTheObject(offset);
   } catch (const Error&) {
@@ -426,7 +379,7 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
   }
   // Hold, still weightless, until the contacts settle; then gravity.
   step(static_cast<int>(std::ceil(kGraspHoldS / tickSeconds())));
-  world_->object->setGravity(world_->world.getGravity());
+  hand_->setObjectGravity(true);
   step(static_cast<int>(std::ceil(e.settle_s / tickSeconds())));
   start.episode = ++episode_;
   return start;

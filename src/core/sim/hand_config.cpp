@@ -52,6 +52,11 @@ JointDriveOptions readDrive(const YAML::Node& node, const std::string& key) {
   return drive;
 }
 
+/// The hand yaml's keys from its parsed document; `yaml_path` names it in messages, relative
+/// paths are resolved against `base`.
+HandConfig readHandConfig(const YAML::Node& root, const std::string& yaml_path,
+                          const fs::path& base);
+
 }  // namespace
 
 Eigen::Isometry3d poseFromXyzRpy(const std::vector<double>& v) {
@@ -82,7 +87,24 @@ HandConfig loadHandConfig(const std::string& yaml_path) {
   } catch (const YAML::Exception& e) {
     throw Error("hand config '" + yaml_path + "': " + e.what());
   }
-  const fs::path base = fs::absolute(fs::path(yaml_path)).parent_path();
+  return readHandConfig(root, yaml_path, fs::absolute(fs::path(yaml_path)).parent_path());
+}
+
+HandConfig parseHandConfig(const std::string& yaml_text, const std::string& source,
+                           const std::string& base_dir) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw Error("hand config '" + source + "': " + e.what());
+  }
+  return readHandConfig(root, source, fs::absolute(fs::path(base_dir)));
+}
+
+namespace {
+
+HandConfig readHandConfig(const YAML::Node& root, const std::string& yaml_path,
+                          const fs::path& base) {
   try {
     HandConfig c;
     if (!root.IsMap()) throw Error("must be a map with hand and sensors");
@@ -176,5 +198,7 @@ HandConfig loadHandConfig(const std::string& yaml_path) {
     throw Error("hand config '" + yaml_path + "': " + e.what());
   }
 }
+
+}  // namespace
 
 }  // namespace norm2tex

@@ -285,20 +285,27 @@ std::string resolveUri(const std::string& uri, const std::string& base_dir,
 
 HandDescription loadHandDescription(const std::string& urdf_path, const PackagePaths& paths,
                                     const std::string& root_link) {
+  return parseHandDescription(readFile(urdf_path), urdf_path,
+                              fs::absolute(fs::path(urdf_path)).parent_path().string(), paths,
+                              root_link);
+}
+
+HandDescription parseHandDescription(const std::string& urdf_xml, const std::string& source,
+                                     const std::string& base_dir, const PackagePaths& paths,
+                                     const std::string& root_link) {
   HandDescription hand;
-  hand.urdf_xml = readFile(urdf_path);
-  const std::string base_dir = fs::absolute(fs::path(urdf_path)).parent_path().string();
+  hand.urdf_xml = urdf_xml;
 
   tinyxml2::XMLDocument document;
   if (document.Parse(hand.urdf_xml.c_str(), hand.urdf_xml.size()) != tinyxml2::XML_SUCCESS) {
     std::ostringstream message;
-    message << urdf_path << ":" << document.ErrorLineNum() << ": not well-formed XML ("
+    message << source << ":" << document.ErrorLineNum() << ": not well-formed XML ("
             << document.ErrorName() << ")";
     throw Error(message.str());
   }
   const tinyxml2::XMLElement* robot = document.FirstChildElement("robot");
-  if (!robot) throw Error(urdf_path + ": not a URDF (no <robot> element)");
-  warnDuplicatedTags(*robot, urdf_path, hand.warnings);
+  if (!robot) throw Error(source + ": not a URDF (no <robot> element)");
+  warnDuplicatedTags(*robot, source, hand.warnings);
   {
     // Visual and collision meshes alike: a URI that cannot be resolved is left as it is (a
     // visual mesh the simulation does not need; a collision mesh fails below with the reason).
@@ -331,12 +338,12 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
     model = urdf::parseURDF(hand.urdf_xml);
   } catch (const std::exception& e) {
     console_bridge::restorePreviousOutputHandler();
-    throw Error(urdf_path + ": invalid URDF: " + e.what());
+    throw Error(source + ": invalid URDF: " + e.what());
   }
   console_bridge::restorePreviousOutputHandler();
   if (!model) {
     throw Error(
-        urdf_path + ": invalid URDF: " +
+        source + ": invalid URDF: " +
         (errors.messages().empty() ? std::string("urdfdom refused it") : errors.messages()));
   }
   hand.name = model->getName();
@@ -344,7 +351,7 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
   urdf::LinkConstSharedPtr root = model->getRoot();
   if (!root_link.empty()) {
     root = model->getLink(root_link);
-    if (!root) throw Error(urdf_path + ": root_link '" + root_link + "' is not a link of the URDF");
+    if (!root) throw Error(source + ": root_link '" + root_link + "' is not a link of the URDF");
   }
 
   // Breadth first from the root: parents before children, as HandSim's kinematics needs.
@@ -367,7 +374,7 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
     if (link->collision_array.empty() && link->collision && link->collision->geometry) {
       out.collisions.push_back(readCollision(*link->collision, link->name, base_dir, paths));
     }
-    repairInertia(out, urdf_path, hand.warnings);
+    repairInertia(out, source, hand.warnings);
     if (next > 0) {
       const urdf::Joint& j = *link->parent_joint;
       HandJoint joint;
@@ -389,13 +396,13 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
           joint.type = HandJoint::Type::kFixed;
           break;
         default:
-          throw Error(urdf_path + ": joint '" + j.name + "' is " + jointTypeName(j.type) +
+          throw Error(source + ": joint '" + j.name + "' is " + jointTypeName(j.type) +
                       ": a hand's joints are revolute, continuous, prismatic or fixed");
       }
       if (joint.movable()) {
         const Eigen::Vector3d axis(j.axis.x, j.axis.y, j.axis.z);
         if (!(axis.norm() > 0.0))
-          throw Error(urdf_path + ": joint '" + j.name + "' has a zero axis");
+          throw Error(source + ": joint '" + j.name + "' has a zero axis");
         joint.axis = axis.normalized();
       }
       if (joint.type == HandJoint::Type::kContinuous) {
@@ -412,7 +419,7 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
       if (joint.movable() && joint.type != HandJoint::Type::kContinuous &&
           !(joint.lower <= joint.upper)) {
         std::ostringstream message;
-        message << urdf_path << ": joint '" << j.name << "' has lower limit " << joint.lower
+        message << source << ": joint '" << j.name << "' has lower limit " << joint.lower
                 << " above its upper limit " << joint.upper;
         throw Error(message.str());
       }
@@ -435,19 +442,19 @@ HandDescription loadHandDescription(const std::string& urdf_path, const PackageP
     const std::string& master = j->mimic->joint_name;
     joint.mimic_master = hand.jointIndex(master);
     if (joint.mimic_master < 0) {
-      throw Error(urdf_path + ": joint '" + joint.name + "' mimics '" + master + "', which " +
+      throw Error(source + ": joint '" + joint.name + "' mimics '" + master + "', which " +
                   (model->getJoint(master) ? "is outside root_link's subtree" : "does not exist"));
     }
     if (!hand.joints[joint.mimic_master].movable() ||
         hand.joints[joint.mimic_master].mimic_master >= 0) {
-      throw Error(urdf_path + ": joint '" + joint.name + "' mimics '" + master +
+      throw Error(source + ": joint '" + joint.name + "' mimics '" + master +
                   "', which is fixed or itself a mimic joint");
     }
   }
   const size_t left_out = model->links_.size() - hand.links.size();
   if (left_out > 0) {
     std::ostringstream message;
-    message << urdf_path << ": " << left_out << " link(s) outside root_link '" << root->name
+    message << source << ": " << left_out << " link(s) outside root_link '" << root->name
             << "' are left out";
     hand.warnings.push_back(message.str());
   }

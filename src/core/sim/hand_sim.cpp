@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include <btBulletDynamicsCommon.h>
 
@@ -44,9 +45,6 @@ struct HandSim::World {
   std::vector<std::unique_ptr<btRigidBody>> links;
   std::unique_ptr<GelPadContacts> gels;
   std::unique_ptr<btRigidBody> object;
-  std::vector<std::unique_ptr<btCollisionShape>> object_shapes;
-  std::vector<ConvexPolytope> contact_parts;
-  std::optional<Capsule> contact_capsule;
 
   ~World() {
     gels.reset();  // its manifolds name the object
@@ -70,11 +68,14 @@ HandSimConfig makeHandSimConfig(const std::string& hand_yaml, const GripperSimCo
   return config;
 }
 
-HandSim::HandSim(const HandSimConfig& config) : config_(config) {
+HandSim::HandSim(const HandSimConfig& config)
+    : HandSim(config, loadHandDescription(config.hand.urdf_path, config.hand.package_paths,
+                                          config.hand.root_link)) {}
+
+HandSim::HandSim(const HandSimConfig& config, HandDescription description)
+    : config_(config), description_(std::move(description)) {
   if (!isPose(config_.hand.base_pose)) throw Error("hand.base_pose is not a finite rigid pose");
   if (!isPose(config_.object_pose)) throw Error("the object's pose is not a finite rigid pose");
-  description_ = loadHandDescription(config_.hand.urdf_path, config_.hand.package_paths,
-                                     config_.hand.root_link);
   warnings_ = description_.warnings;
   base_pose_ = config_.hand.base_pose;
   for (const SensorMount& mount : config_.hand.sensors) {
@@ -131,6 +132,7 @@ HandSim::HandSim(const HandSimConfig& config) : config_(config) {
   const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
   object_in_body_ = Eigen::Translation3d(-centre);
   checkMounts();
+  makeCollision();
   buildWorld();
 }
 
@@ -248,6 +250,24 @@ void HandSim::checkMounts() {
   }
 }
 
+void HandSim::makeCollision() {
+  // The hull's hollows are measured against the first gel's normal, with the object and the
+  // hand as constructed. (A convex decomposition takes HACD a good part of a second: episodes
+  // that reset the hand must not redo it.)
+  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
+  Eigen::Vector3d gel_axis = Eigen::Vector3d::UnitY();
+  if (!sensor_links_.empty()) {
+    gel_axis =
+        (config_.object_pose.linear().transpose() * gelInWorld(0).linear().col(2)).normalized();
+  }
+  ObjectCollisionShapes shapes = makeObjectCollision(
+      object_, config_.object.collision, centre, config_.gel_law.points().back().first, gel_axis);
+  object_shapes_ = std::move(shapes.shapes);
+  contact_parts_ = std::move(shapes.contact_parts);
+  contact_capsule_ = shapes.contact_capsule;
+  collision_ = shapes.collision;
+}
+
 void HandSim::buildWorld() {
   world_ = std::make_unique<World>();
   World& w = *world_;
@@ -309,31 +329,18 @@ void HandSim::buildWorld() {
     w.links[l] = std::move(body);
   }
 
-  // Gels: the package's compliant contact, added before the object as GripperSim's.
+  // Gels: the package's compliant contact, added before the object (whose body attach() takes).
   GelPadOptions pads =
       gelPadOptionsOf(config_, static_cast<double>(object_.mesh.bounds().sizes().minCoeff()) / 2.0);
-  // A hand's gel can have the object behind it (behind its finger, across the palm), where
-  // GripperSim's two facing gels never do: a part reaching further behind the gel's surface
-  // than twice its thickness is on the sensor's other side, not pressed into its gel.
+  // A hand's gel can have the object behind it (behind its finger, across the palm), where two
+  // facing gels (the built-in gripper's) never do: a part reaching further behind the gel's
+  // surface than twice its thickness is on the sensor's other side, not pressed into its gel.
   pads.behind_gel_m = 2.0 * config_.gel_thickness_m;
   w.gels = std::make_unique<GelPadContacts>(
       w.world, w.dispatcher, static_cast<int>(sensor_links_.size()), pads, kGelGroup);
 
-  // Object: dynamic, its body at its bounds' centre. The hull's hollows are measured against
-  // the first gel's normal at the start.
-  const Eigen::Vector3d centre = object_.mesh.bounds().center().cast<double>();
-  Eigen::Vector3d gel_axis = Eigen::Vector3d::UnitY();
-  if (!sensor_links_.empty()) {
-    gel_axis =
-        (config_.object_pose.linear().transpose() * gelInWorld(0).linear().col(2)).normalized();
-  }
-  ObjectCollisionShapes shapes = makeObjectCollision(
-      object_, config_.object.collision, centre, config_.gel_law.points().back().first, gel_axis);
-  w.object_shapes = std::move(shapes.shapes);
-  w.contact_parts = std::move(shapes.contact_parts);
-  w.contact_capsule = shapes.contact_capsule;
-  collision_ = shapes.collision;
-  btCollisionShape* shape = w.object_shapes.back().get();
+  // Object: dynamic, its body at its bounds' centre.
+  btCollisionShape* shape = object_shapes_.back().get();
   btVector3 inertia(0, 0, 0);
   shape->calculateLocalInertia(config_.object.mass_kg, inertia);
   btRigidBody::btRigidBodyConstructionInfo info(config_.object.mass_kg, nullptr, shape, inertia);
@@ -346,7 +353,7 @@ void HandSim::buildWorld() {
   w.object->setWorldTransform(toBt(config_.object_pose * object_in_body_.inverse()));
   w.world.addRigidBody(w.object.get(), kObjectGroup, btBroadphaseProxy::StaticFilter | kLinkGroup);
 
-  w.gels->attach(*w.object, GelContactGeometry{&w.contact_parts, &w.contact_capsule});
+  w.gels->attach(*w.object, GelContactGeometry{&contact_parts_, &contact_capsule_});
   contacts_.assign(sensor_links_.size(), GelContactState{});
   placeBodies();
   for (size_t s = 0; s < sensor_links_.size(); ++s) {
@@ -509,8 +516,39 @@ void HandSim::resetObject(const Eigen::Isometry3d& object_in_world, bool gravity
 void HandSim::reset(const Eigen::Isometry3d* object_in_world) {
   if (object_in_world && !isPose(*object_in_world))
     throw Error("object pose is not a finite rigid pose");
+  restart(object_in_world, {}, {});
+}
+
+void HandSim::reset(const Eigen::Isometry3d& object_in_world,
+                    const std::vector<std::string>& joint_names,
+                    const std::vector<double>& joint_positions) {
+  if (!isPose(object_in_world)) throw Error("object pose is not a finite rigid pose");
+  const std::vector<int> joints = validateNames(joint_names);
+  if (joint_positions.size() != joint_names.size()) {
+    throw Error("joint positions: " + std::to_string(joint_names.size()) + " names but " +
+                std::to_string(joint_positions.size()) + " positions");
+  }
+  for (size_t i = 0; i < joint_positions.size(); ++i) {
+    if (!std::isfinite(joint_positions[i]))
+      throw Error("joint '" + joint_names[i] + "': position is not finite");
+  }
+  restart(&object_in_world, joints, joint_positions);
+}
+
+void HandSim::restart(const Eigen::Isometry3d* object_in_world, const std::vector<int>& joints,
+                      const std::vector<double>& positions) {
   if (object_in_world) config_.object_pose = *object_in_world;
   q_ = initial_q_;
+  for (size_t i = 0; i < joints.size(); ++i) {
+    bool clamped = false;
+    q_[joints[i]] = clampToLimits(joints[i], positions[i], clamped);
+  }
+  for (size_t j = 0; j < q_.size(); ++j) {
+    const HandJoint& joint = description_.joints[j];
+    if (joint.mimic_master >= 0) {
+      q_[j] = joint.mimic_multiplier * q_[joint.mimic_master] + joint.mimic_offset;
+    }
+  }
   drive_q_ = q_;
   target_ = q_;
   std::fill(load_.begin(), load_.end(), 0.0);
@@ -520,6 +558,13 @@ void HandSim::reset(const Eigen::Isometry3d* object_in_world) {
   base_tick_ = base_ticks_ = 0;
   forwardKinematics();
   buildWorld();
+}
+
+bool HandSim::objectReachesIntoGel(int sensor) const {
+  for (const std::vector<GelContactPoint>& part : world_->gels->objectPointsIn(sensor)) {
+    if (!part.empty()) return true;
+  }
+  return false;
 }
 
 void HandSim::setObjectGravity(bool on) {
@@ -564,7 +609,7 @@ void HandSim::moveJoints(double dt) {
     double move = std::clamp(target_[j] - drive_q_[j], -max_move, max_move);
     // A drive pushes against its load with at most its effort: it advances into the load only
     // as far as the contact's stiffness lets the load grow to the effort, and yields where the
-    // load exceeds it (one Newton step a tick, as GripperSim's compliant drive). Against a rigid
+    // load exceeds it (one Newton step a tick, as the drive's stiffness below). Against a rigid
     // contact (no gel on the way) it stops.
     const double into = load < 0.0 ? 1.0 : -1.0;  // the direction that pushes into the load
     const double excess = std::abs(load) - d.effort;
