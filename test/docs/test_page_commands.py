@@ -160,11 +160,20 @@ for _i, (_force, _press) in enumerate([("2", "0.3"), ("5", "0.45"), ("12", "0.6"
     CALIBRATION_FILES["wood_%d.png" % _i] = [
         "norm2tex_render", "--mesh", "box:30x30x10", "--pose", "0 0 0.005 0.1 0 0", "--press-mm",
         _press, "--material", "wood", "--force-n", _force, "--background", "bg.png", "-o"]
+# calibration.md's second session to judge a sensor on (bg2.png, press2_*.png): the fixtures hold
+# one session of real presses, so the same frames again.
+JUDGE_FILES = dict([("bg2.png", os.path.join(S09, "frame_30.jpg"))] +
+                   [("press2_%02d.png" % i, f) for i, f in enumerate(REAL_PRESSES)])
+# Two presses of the 6 mm ball 8 mm apart along the gel (--scale-presses here.png moved.png
+# --scale-distance-mm 8): rendered by norm2tex_render onto bg.png.
+SCALE_FILES = {name: ["norm2tex_render", "--mesh", "sphere:3", "--pose", "%s 0 0.003 0 0 0" % x,
+                      "--press-mm", "0.5", "--background", "bg.png", "-o"]
+               for name, x in (("here.png", "-0.004"), ("moved.png", "0.004"))}
 # norm2tex_make_demo_normal_map: the package's normal map of known relief (waves, bumps, ridges).
 DEMO_NORMAL_MAP = ["norm2tex_make_demo_normal_map", "--size", "256", "-o"]
 FILES = {
     "README.md": dict(CALIBRATION_FILES, **{"my_normal.png": DEMO_NORMAL_MAP}),
-    "docs/calibration.md": CALIBRATION_FILES,
+    "docs/calibration.md": dict(CALIBRATION_FILES, **JUDGE_FILES, **SCALE_FILES),
     # A material yaml of your own: the shipped wood's.
     "docs/materials.md": {"my_wood.yaml": os.path.join(ROOT, "config", "materials", "wood.yaml")},
     "docs/texture.md": {"my_normal.png": DEMO_NORMAL_MAP},
