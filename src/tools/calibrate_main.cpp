@@ -78,7 +78,7 @@ norm2tex::cli::Program makeProgram() {
       ("scale-distance-mm", po::value<double>()->value_name("D"),
        "How far the press moved between the two --scale-presses frames, mm.")  //
       ("judge", po::value<std::string>()->value_name("SENSOR.yaml"),
-       "Fit nothing: judge this calibrated sensor on the presses given (another session of the "
+       "Fit nothing: judge this calibrated sensor on the presses given (another recording of the "
        "same unit, or another unit), every one held out, as a fit's held-out presses are "
        "judged. Writes no sensor yaml.")  //
       ("output,o", po::value<std::string>()->value_name("SENSOR.yaml"),

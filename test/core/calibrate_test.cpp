@@ -221,7 +221,7 @@ NamedFrame fixtureFrame(int index) {
   return {path, image};
 }
 
-// Real presses of one DIGIT (6 mm ball, 0.0532 mm/px; another session of the unit the default
+// Real presses of one DIGIT (6 mm ball, 0.0532 mm/px; another recording of the unit the default
 // was fitted on): calibrate on half, render the other half at the fitted geometry, compare.
 TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
   CalibrationInput input;
@@ -272,10 +272,10 @@ TEST(Calibration, RealPressesAreReproducedOnTheHeldOutHalf) {
   }
 }
 
-// The shipped sensor, fitted on one session of the unit (vocdex/Taxim sphere2), judged on the
+// The shipped sensor, fitted on one recording of the unit (vocdex/Taxim sphere2), judged on the
 // other (the fixture: sphere, another day, another background): every press held out, nothing
 // fitted. Goal of the realism work: at least 0.85 of the variance, the rim shadow within 20 %.
-TEST(Calibration, TheShippedSensorIsJudgedOnTheUnitsOtherSession) {
+TEST(Calibration, TheShippedSensorIsJudgedOnTheUnitsOtherRecording) {
   CalibrationInput input;
   input.backgrounds.push_back(fixtureFrame(30));
   for (int i = 0; i <= 28; i += 2) input.presses.push_back(fixtureFrame(i));

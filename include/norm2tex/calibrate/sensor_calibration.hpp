@@ -70,7 +70,7 @@ constexpr int kMinCalibrationPresses = 4;
 CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
                                   const CalibrationOptions& options = {});
 
-/// Judges a calibrated sensor on presses it was not fitted on (another session of the same
+/// Judges a calibrated sensor on presses it was not fitted on (another recording of the same
 /// unit, or another unit): every press is held out. The circles are found as the calibration
 /// finds its held-out presses' (detected or labelled, drift removed, refined against `fitted`,
 /// geometry only); each is rendered by `fitted` on the mean of these backgrounds and compared
