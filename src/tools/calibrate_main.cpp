@@ -172,6 +172,24 @@ void warnAboutFittedScale(const norm2tex::ShadingFit& fit) {
   }
 }
 
+// --report and --json, then the summary a fit and a judgement print alike.
+void reportOn(const po::variables_map& args, const std::string& json_path,
+              const norm2tex::CalibrationResult& result, const norm2tex::CalibrationInput& input,
+              std::chrono::steady_clock::time_point start, const std::string& what) {
+  if (args.count("report")) {
+    norm2tex::writeImage(args["report"].as<std::string>(), norm2tex::makeCalibrationReport(result));
+  }
+  if (args.count("json")) {
+    norm2tex::writeCalibrationReportJson(json_path, result, input.ball_diameter_mm);
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s on %zu presses in %.1f s\n", what.c_str(), input.presses.size(), seconds);
+  for (const std::string& line : norm2tex::describeFitQuality(result)) {
+    std::printf("  %s\n", line.c_str());
+  }
+}
+
 int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   // The fit renders thousands of presses through frame-sized temporaries: reused, not faulted
   // in afresh each time (~3x faster calibration).
@@ -248,20 +266,7 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
     const std::string sensor = args["judge"].as<std::string>();
     const norm2tex::CalibrationResult result =
         norm2tex::judgeSensor(norm2tex::loadSensorModel(sensor), input);
-    if (args.count("report")) {
-      norm2tex::writeImage(args["report"].as<std::string>(),
-                           norm2tex::makeCalibrationReport(result));
-    }
-    if (args.count("json")) {
-      norm2tex::writeCalibrationReportJson(json_path, result, input.ball_diameter_mm);
-    }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%s: judged on %zu presses in %.1f s\n", sensor.c_str(), input.presses.size(),
-                seconds);
-    for (const std::string& line : norm2tex::describeFitQuality(result)) {
-      std::printf("  %s\n", line.c_str());
-    }
+    reportOn(args, json_path, result, input, start, sensor + ": judged");
     return 0;
   }
   const norm2tex::SensorModel base = baseModel(args, input.backgrounds.front().image.size());
@@ -274,19 +279,7 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   norm2tex::SensorModel model = result.model;
   model.background_image = background_name;
   norm2tex::saveSensorModel(model, output);
-  if (args.count("report")) {
-    norm2tex::writeImage(args["report"].as<std::string>(), norm2tex::makeCalibrationReport(result));
-  }
-  if (args.count("json")) {
-    norm2tex::writeCalibrationReportJson(json_path, result, input.ball_diameter_mm);
-  }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::printf("%s: calibrated on %zu presses in %.1f s\n", output.c_str(), input.presses.size(),
-              seconds);
-  for (const std::string& line : norm2tex::describeFitQuality(result)) {
-    std::printf("  %s\n", line.c_str());
-  }
+  reportOn(args, json_path, result, input, start, output + ": calibrated");
   for (const std::string& line : norm2tex::describeScaleSearch(result.fit)) {
     std::printf("  %s\n", line.c_str());
   }

@@ -239,5 +239,7 @@ class HandSim {
 /// Reads a hand yaml and makes the rest of a HandSimConfig from a scene yaml's object, physics
 /// and gel law (loadGripperSimConfig) and the sensor's gel pad.
 HandSimConfig makeHandSimConfig(const std::string& hand_yaml, const GripperSimConfig& scene);
+/// The same for a hand config already read.
+HandSimConfig makeHandSimConfig(HandConfig hand, const GripperSimConfig& scene);
 
 }  // namespace norm2tex

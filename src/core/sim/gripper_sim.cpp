@@ -6,6 +6,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "norm2tex/common/error.hpp"
@@ -85,15 +86,10 @@ HandSimConfig builtInHand(const GripperSimConfig& scene) {
   config.hand.gripper_joints = {kFingerJoint};
   config.hand.gripper_closed = {g.min_gap_m / 2.0};
   config.hand.gripper_open = {g.max_gap_m / 2.0};
-  config.object = scene.object;
+  HandSimConfig sim = makeHandSimConfig(std::move(config.hand), scene);
   // Where the constructor seats it once the mesh (loaded by HandSim) tells its centre.
-  config.object_pose = config.hand.base_pose;
-  config.physics = scene.physics;
-  config.gel_law = scene.gel_law;
-  config.gel_width_m = scene.gel_width_m;
-  config.gel_height_m = scene.gel_height_m;
-  config.gel_thickness_m = scene.gel_thickness_m;
-  return config;
+  sim.object_pose = sim.hand.base_pose;
+  return sim;
 }
 
 }  // namespace

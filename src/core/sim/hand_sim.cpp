@@ -57,8 +57,12 @@ struct HandSim::World {
 };
 
 HandSimConfig makeHandSimConfig(const std::string& hand_yaml, const GripperSimConfig& scene) {
+  return makeHandSimConfig(loadHandConfig(hand_yaml), scene);
+}
+
+HandSimConfig makeHandSimConfig(HandConfig hand, const GripperSimConfig& scene) {
   HandSimConfig config;
-  config.hand = loadHandConfig(hand_yaml);
+  config.hand = std::move(hand);
   config.object = scene.object;
   config.physics = scene.physics;
   config.gel_law = scene.gel_law;
