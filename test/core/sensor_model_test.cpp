@@ -119,6 +119,49 @@ TEST(SensorModel, UnknownKeysAreErrorsNamingTheKey) {
   expectUnknown("leds: [{name: a, colour: [1, 0, 0]}, {name: b}, {name: c}]\n", "leds[].colour");
 }
 
+// The marker grid and the gel's shear section: off by default (a DIGIT has no markers), read,
+// saved and loaded back, and every bad value named.
+TEST(SensorModel, MarkersAndShearLoadSaveAndRejectBadValues) {
+  test::ScratchDirectory dir;
+  EXPECT_FALSE(makeDigitSensorModel().markers.enabled);
+  EXPECT_FALSE(loadSensorModel(NORM2TEX_SOURCE_DIR "/config/digit.yaml").markers.enabled);
+  std::ofstream(dir.path("markers.yaml"))
+      << "markers: {enabled: true, rows: 5, cols: 6, pitch_mm: 1.2, dot_diameter_mm: 0.4,\n"
+         "  darkness: 0.5, blur_mm: 0.03, jitter_mm: 0.05, seed: 7, offset_mm: [0.1, -0.2]}\n"
+         "shear: {shear_modulus_mpa: 0.3, friction: 0.8}\n";
+  const SensorModel m = loadSensorModel(dir.path("markers.yaml"));
+  EXPECT_TRUE(m.markers.enabled);
+  EXPECT_EQ(m.markers.rows, 5);
+  EXPECT_EQ(m.markers.cols, 6);
+  EXPECT_DOUBLE_EQ(m.markers.pitch_mm, 1.2);
+  EXPECT_DOUBLE_EQ(m.markers.dot_diameter_mm, 0.4);
+  EXPECT_DOUBLE_EQ(m.markers.darkness, 0.5);
+  EXPECT_DOUBLE_EQ(m.markers.jitter_mm, 0.05);
+  EXPECT_EQ(m.markers.seed, 7);
+  EXPECT_DOUBLE_EQ(m.markers.offset_mm[1], -0.2);
+  EXPECT_DOUBLE_EQ(m.shear.shear_modulus_mpa, 0.3);
+  EXPECT_DOUBLE_EQ(m.shear.friction, 0.8);
+  saveSensorModel(m, dir.path("saved.yaml"));
+  const SensorModel loaded = loadSensorModel(dir.path("saved.yaml"));
+  EXPECT_TRUE(loaded.markers.enabled);
+  EXPECT_EQ(loaded.markers.cols, 6);
+  EXPECT_DOUBLE_EQ(loaded.markers.blur_mm, 0.03);
+  EXPECT_DOUBLE_EQ(loaded.markers.offset_mm[0], 0.1);
+  EXPECT_DOUBLE_EQ(loaded.shear.friction, 0.8);
+  const auto expectBad = [&](const std::string& yaml, std::vector<std::string> words) {
+    std::ofstream(dir.path("bad.yaml")) << yaml;
+    test::expectError([&] { loadSensorModel(dir.path("bad.yaml")); }, words);
+  };
+  expectBad("markers: {rows: 0}\n", {"markers.rows", "[1, 200]"});
+  expectBad("markers: {pitch_mm: 1.0, dot_diameter_mm: 1.2}\n",
+            {"markers.dot_diameter_mm", "pitch_mm"});
+  expectBad("markers: {darkness: 1.5}\n", {"markers.darkness", "[0, 1]"});
+  expectBad("markers: {offset_mm: [1]}\n", {"markers.offset_mm", "2 numbers"});
+  expectBad("markers: {pitch: 1}\n", {"unknown key 'markers.pitch'"});
+  expectBad("shear: {shear_modulus_mpa: -1}\n", {"shear.shear_modulus_mpa", "(0, 100] MPa"});
+  expectBad("shear: {friction: .nan}\n", {"shear.friction"});
+}
+
 TEST(SensorModel, PixelCentresMapToTheGelFrame) {
   const SensorModel m = makeDigitSensorModel();
   const cv::Point2d top_left = m.pixelToGelMm(0, 0);

@@ -89,6 +89,35 @@ struct ConformityOptions {
   double coating_length_mm = 0.23;
 };
 
+/// A printed dot grid on the gel's surface (GelSight Mini's gels carry one; DIGIT's do not).
+/// The dots ride on the gel's lateral displacement (ShearField) and are drawn into the image
+/// before the shading's difference is added, so they darken and move as real ones do.
+struct MarkerOptions {
+  bool enabled = false;          ///< off: frames exactly as without markers
+  int rows = 7;                  ///< dots along the image's rows (down)
+  int cols = 9;                  ///< dots along the image's columns (right)
+  double pitch_mm = 1.8;         ///< centre-to-centre spacing, both directions
+  double dot_diameter_mm = 0.5;  ///< printed dot diameter
+  /// Fraction of the light a dot takes at its centre, 0..1 (0.7: a dot shows 30 % of the
+  /// background's brightness there).
+  double darkness = 0.7;
+  double blur_mm = 0.04;         ///< Gaussian sigma of the dots' edge (print, coating, optics)
+  double jitter_mm = 0.0;        ///< random offset of each dot (uniform, +-), seeded
+  int seed = 0;                  ///< the jitter's seed
+  /// The grid's centre from the image centre (gel frame x, y), mm.
+  std::array<double, 2> offset_mm{0.0, 0.0};
+};
+
+/// The gel's lateral mechanics (ShearField): the surface's displacement under the contact's
+/// tangential traction, an incompressible elastic layer of gel.thickness_mm bonded to the
+/// rigid window behind it.
+struct ShearOptions {
+  /// Shear modulus G of the gel, MPa (E = 3 G for an incompressible gel).
+  double shear_modulus_mpa = 0.1;
+  /// Coulomb friction coefficient between gel and object when the caller gives none.
+  double friction = 1.0;
+};
+
 /// Everything about one DIGIT that the renderer needs, loaded from config/digit.yaml.
 ///
 /// Gel frame (shared by the CLI, the tests and the ROS nodes): origin at the centre of the
@@ -117,6 +146,8 @@ struct SensorModel {
   std::string background_image;  ///< user's no-contact frame (BGR); empty = synthetic
   GelOptions gel;
   ConformityOptions conformity;
+  MarkerOptions markers;
+  ShearOptions shear;
 
   /// The imaged part of the gel (cols x mm_per_pixel by rows x mm_per_pixel).
   double gelWidthMm() const { return cols * mm_per_pixel; }

@@ -35,7 +35,7 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
   static const std::map<std::string, std::set<std::string>> keys = {
       {"",
        {"preset", "image", "gel", "camera", "leds", "shading", "noise", "background_image",
-        "gel_model", "conformity"}},
+        "gel_model", "conformity", "markers", "shear"}},
       {"image", {"rows", "cols", "mm_per_pixel"}},
       {"gel", {"thickness_mm", "curvature_radius_mm", "pad_width_mm", "pad_height_mm"}},
       {"camera", {"fx", "fy", "cx", "cy"}},
@@ -47,6 +47,10 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
         "on_real_background"}},
       {"gel_model", {"pyramid_sigmas_mm", "core_fraction", "final_sigma_mm"}},
       {"conformity", {"enabled", "contact_modulus_mpa", "coating_length_mm"}},
+      {"markers",
+       {"enabled", "rows", "cols", "pitch_mm", "dot_diameter_mm", "darkness", "blur_mm",
+        "jitter_mm", "seed", "offset_mm"}},
+      {"shear", {"shear_modulus_mpa", "friction"}},
   };
   return keys.at(section);
 }
@@ -126,6 +130,51 @@ void readNoise(const YAML::Node& node, NoiseOptions& noise) {
   read(node, "correlation_gr", noise.correlation_gr);
   read(node, "correlation_br", noise.correlation_br);
   read(node, "on_real_background", noise.on_real_background);
+}
+
+void readMarkers(const YAML::Node& node, MarkerOptions& markers) {
+  if (!node) return;
+  rejectUnknownKeys(node, "markers");
+  read(node, "enabled", markers.enabled);
+  read(node, "rows", markers.rows);
+  read(node, "cols", markers.cols);
+  read(node, "pitch_mm", markers.pitch_mm);
+  read(node, "dot_diameter_mm", markers.dot_diameter_mm);
+  read(node, "darkness", markers.darkness);
+  read(node, "blur_mm", markers.blur_mm);
+  read(node, "jitter_mm", markers.jitter_mm);
+  read(node, "seed", markers.seed);
+  if (node["offset_mm"]) {
+    const std::vector<double> values = node["offset_mm"].as<std::vector<double>>();
+    if (values.size() != 2)
+      throw Error("markers.offset_mm needs 2 numbers, got " + std::to_string(values.size()));
+    markers.offset_mm = {values[0], values[1]};
+  }
+}
+
+void validateMarkers(const SensorModel& m) {
+  using detail::requireParameter;
+  const MarkerOptions& k = m.markers;
+  requireParameter(k.rows >= 1 && k.rows <= 200, "markers.rows", k.rows, "[1, 200]");
+  requireParameter(k.cols >= 1 && k.cols <= 200, "markers.cols", k.cols, "[1, 200]");
+  requireParameter(k.pitch_mm > 0.0 && k.pitch_mm <= 20.0, "markers.pitch_mm", k.pitch_mm,
+                   "(0, 20] mm");
+  requireParameter(k.dot_diameter_mm > 0.0 && k.dot_diameter_mm < k.pitch_mm,
+                   "markers.dot_diameter_mm", k.dot_diameter_mm,
+                   "(0, pitch_mm) mm (dots that touch are no grid)");
+  requireParameter(k.darkness >= 0.0 && k.darkness <= 1.0, "markers.darkness", k.darkness,
+                   "[0, 1]");
+  requireParameter(k.blur_mm >= 0.0 && k.blur_mm <= 1.0, "markers.blur_mm", k.blur_mm,
+                   "[0, 1] mm");
+  requireParameter(k.jitter_mm >= 0.0 && k.jitter_mm <= 0.5 * k.pitch_mm, "markers.jitter_mm",
+                   k.jitter_mm, "[0, pitch_mm / 2] mm");
+  requireParameter(std::isfinite(k.offset_mm[0]) && std::isfinite(k.offset_mm[1]) &&
+                       std::abs(k.offset_mm[0]) <= 50.0 && std::abs(k.offset_mm[1]) <= 50.0,
+                   "markers.offset_mm", k.offset_mm[0], "finite, within +-50 mm");
+  requireParameter(m.shear.shear_modulus_mpa > 0.0 && m.shear.shear_modulus_mpa <= 100.0,
+                   "shear.shear_modulus_mpa", m.shear.shear_modulus_mpa, "(0, 100] MPa");
+  requireParameter(m.shear.friction > 0.0 && m.shear.friction <= 10.0, "shear.friction",
+                   m.shear.friction, "(0, 10]");
 }
 
 }  // namespace
@@ -228,6 +277,7 @@ void validate(const SensorModel& m) {
                    "(0, 100] MPa");
   requireParameter(m.conformity.coating_length_mm >= 0.0 && m.conformity.coating_length_mm <= 2.0,
                    "conformity.coating_length_mm", m.conformity.coating_length_mm, "[0, 2] mm");
+  validateMarkers(m);
 }
 
 SensorModel loadSensorModel(const std::string& yaml_path) {
@@ -286,6 +336,12 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
       read(conformity, "enabled", m.conformity.enabled);
       read(conformity, "contact_modulus_mpa", m.conformity.contact_modulus_mpa);
       read(conformity, "coating_length_mm", m.conformity.coating_length_mm);
+    }
+    readMarkers(root["markers"], m.markers);
+    if (const YAML::Node shear = root["shear"]) {
+      rejectUnknownKeys(shear, "shear");
+      read(shear, "shear_modulus_mpa", m.shear.shear_modulus_mpa);
+      read(shear, "friction", m.shear.friction);
     }
     if (!m.background_image.empty() && std::filesystem::path(m.background_image).is_relative()) {
       m.background_image =
@@ -357,6 +413,14 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
       << "conformity:\n  enabled: " << (m.conformity.enabled ? "true" : "false")
       << "\n  contact_modulus_mpa: " << m.conformity.contact_modulus_mpa
       << "\n  coating_length_mm: " << m.conformity.coating_length_mm << "\n";
+  const MarkerOptions& k = m.markers;
+  out << "markers:\n  enabled: " << (k.enabled ? "true" : "false") << "\n  rows: " << k.rows
+      << "\n  cols: " << k.cols << "\n  pitch_mm: " << k.pitch_mm
+      << "\n  dot_diameter_mm: " << k.dot_diameter_mm << "\n  darkness: " << k.darkness
+      << "\n  blur_mm: " << k.blur_mm << "\n  jitter_mm: " << k.jitter_mm << "\n  seed: " << k.seed
+      << "\n  offset_mm: [" << k.offset_mm[0] << ", " << k.offset_mm[1] << "]\n"
+      << "shear:\n  shear_modulus_mpa: " << m.shear.shear_modulus_mpa
+      << "\n  friction: " << m.shear.friction << "\n";
   std::ofstream file(yaml_path);
   file << out.str();
   file.close();
