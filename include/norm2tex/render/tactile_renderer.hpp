@@ -17,6 +17,7 @@
 #include "norm2tex/render/texture_overlay.hpp"
 #include "norm2tex/mesh/textured_mesh.hpp"
 #include "norm2tex/gel/gel_law.hpp"
+#include "norm2tex/shear/shear_field.hpp"
 
 namespace norm2tex {
 
@@ -30,6 +31,9 @@ struct TactileFrame {
   bool textured = false;   ///< whether the overlay ran
   /// What the conformity model computed (set when it ran: conformity on and textured).
   std::optional<ConformityStats> conformity;
+  /// The gel's lateral motion (set when render() was given a shear load, or the sensor has
+  /// markers: then at rest without a load).
+  std::optional<ShearFrame> shear;
 
   /// gel_mm in metres (32FC1), as published on the depth topic.
   cv::Mat1f depthMetres() const;
@@ -52,10 +56,13 @@ class TactileRenderer {
   /// Renders the object at `object_in_gel` (metres, gel frame). `noise_seed` < 0: no noise.
   /// `normal_force_n`: the contact's normal force (N), which sets how much of the texture the
   /// gel follows when the model's conformity is on; without it, the gel law's force for the
-  /// deepest indentation. Throws Error for a non-finite pose, a negative or non-finite force,
-  /// or when no object was set.
+  /// deepest indentation. `shear`: the contact's tangential load, which moves the gel's surface
+  /// sideways (ShearField: frame.shear) and carries the markers; without it the surface stays
+  /// in place. Throws Error for a non-finite pose, a negative or non-finite force or load, or
+  /// when no object was set.
   const TactileFrame& render(const Eigen::Isometry3d& object_in_gel, std::int64_t noise_seed,
-                             std::optional<double> normal_force_n = std::nullopt);
+                             std::optional<double> normal_force_n = std::nullopt,
+                             const std::optional<ShearLoad>& shear = std::nullopt);
 
   /// The force-indentation law that gives the force of a press when render() is given none
   /// (default: GelLaw::taximDefault(), the scenes' default law).
@@ -68,6 +75,8 @@ class TactileRenderer {
  private:
   // GelConformity on the overlay's relief; rewrites h_final_ over the covered box.
   ConformityStats applyConformity(std::optional<double> normal_force_n);
+  // The force of this press: the given one, else the gel law's for the deepest H_sensor.
+  double pressForce(std::optional<double> normal_force_n) const;
 
   SensorModel model_;
   ContactRasterizer rasterizer_;
@@ -76,6 +85,7 @@ class TactileRenderer {
   std::shared_ptr<const TexturedMesh> mesh_;
   std::optional<TextureOverlay> overlay_;
   std::optional<GelConformity> conformity_;  // set when model.conformity.enabled
+  std::unique_ptr<ShearField> shear_;          // made on the first load, or at once with markers
   GelLaw gel_law_ = GelLaw::taximDefault();
   TactileFrame frame_;
   cv::Mat1f h_final_;

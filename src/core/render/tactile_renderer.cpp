@@ -35,6 +35,7 @@ TactileRenderer::TactileRenderer(const SensorModel& model, cv::Mat3b background,
       gel_(model),
       shader_(model, std::move(background), source) {
   if (model_.conformity.enabled) conformity_.emplace(model_.conformity, model_.mm_per_pixel);
+  if (model_.markers.enabled) shear_ = std::make_unique<ShearField>(model_);
 }
 
 std::string TactileRenderer::setObject(std::shared_ptr<const TexturedMesh> mesh,
@@ -57,7 +58,8 @@ std::string TactileRenderer::setObject(std::shared_ptr<const TexturedMesh> mesh,
 
 const TactileFrame& TactileRenderer::render(const Eigen::Isometry3d& object_in_gel,
                                             std::int64_t noise_seed,
-                                            std::optional<double> normal_force_n) {
+                                            std::optional<double> normal_force_n,
+                                            const std::optional<ShearLoad>& shear) {
   if (!mesh_) throw Error("TactileRenderer::render: no object set");
   if (normal_force_n && !(std::isfinite(*normal_force_n) && *normal_force_n >= 0.0)) {
     throw Error("TactileRenderer::render: normal force = " + std::to_string(*normal_force_n) +
@@ -88,21 +90,35 @@ const TactileFrame& TactileRenderer::render(const Eigen::Isometry3d& object_in_g
   cv::compare(*h_final, 0.0f, frame_.contact_mask, cv::CMP_GT);
   gel_.apply(*h_final, frame_.gel_mm);
   frame_.image = shader_.shade(frame_.gel_mm, noise_seed);
+  if (shear && !shear_) shear_ = std::make_unique<ShearField>(model_);
+  if (shear) {
+    if (!frame_.shear) frame_.shear.emplace();
+    shear_->compute(frame_.raster.h_sensor_mm, frame_.raster.covered_box,
+                    pressForce(normal_force_n), *shear, *frame_.shear);
+  } else if (shear_ && shear_->hasMarkers()) {
+    if (!frame_.shear) frame_.shear.emplace();
+    shear_->rest(*frame_.shear);
+  } else {
+    frame_.shear.reset();
+  }
+  if (frame_.shear) shear_->drawMarkers(frame_.image, *frame_.shear);
   return frame_;
+}
+
+double TactileRenderer::pressForce(std::optional<double> normal_force_n) const {
+  if (normal_force_n) return *normal_force_n;
+  const cv::Rect box = frame_.raster.covered_box;
+  if (box.empty()) return 0.0;
+  double deepest_mm = 0.0;
+  cv::minMaxLoc(frame_.raster.h_sensor_mm(box), nullptr, &deepest_mm);
+  return gel_law_.force(deepest_mm * 1e-3);
 }
 
 ConformityStats TactileRenderer::applyConformity(std::optional<double> normal_force_n) {
   const cv::Rect box = frame_.raster.covered_box;
   const cv::Mat1f& h_sensor = frame_.raster.h_sensor_mm;
   if (box.empty()) return ConformityStats{};
-  double force_n = 0.0;
-  if (normal_force_n) {
-    force_n = *normal_force_n;
-  } else {
-    double deepest_mm = 0.0;
-    cv::minMaxLoc(h_sensor(box), nullptr, &deepest_mm);
-    force_n = gel_law_.force(deepest_mm * 1e-3);
-  }
+  const double force_n = pressForce(normal_force_n);
   // H_final again, as the overlay computes it, from the followed relief instead of the full one.
   return conformity_->applyToFinal(h_sensor, frame_.h_local, overlay_->betaMm(), box, force_n,
                                    frame_.raster.gap_mm, model_.gel_thickness_mm, h_final_);
