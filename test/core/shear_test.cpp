@@ -13,6 +13,7 @@
 #include "norm2tex/render/tactile_renderer.hpp"
 #include "norm2tex/shear/cerruti_kernel.hpp"
 #include "norm2tex/shear/contact_traction.hpp"
+#include "norm2tex/shear/layer_compliance.hpp"
 #include "norm2tex/shear/marker_pattern.hpp"
 #include "norm2tex/shear/shear_field.hpp"
 #include "norm2tex/shear/surface_displacement.hpp"
@@ -95,9 +96,67 @@ TEST(SurfaceDisplacement, UniformTractionOnADiscMatchesCerrutiAtTheCentreAndAsIt
   EXPECT_NEAR(ux(mid, n - 1) / ux(n - 1, mid), 2.0, 0.1);
 }
 
+// The layer's compliance between its two limits: a half-space's 1/k and 1/(2k) at wavelengths
+// far below the thickness, the simple shear h / G of a thin layer far above it, and the
+// antiplane mode's closed form tanh(kh) / k in between.
+TEST(LayerCompliance, TendsToTheHalfSpaceAndToSimpleShear) {
+  const double h = 4.0;
+  for (const double kh : {8.0, 12.0, 14.9}) {
+    const LayerCompliance c = layerCompliance(kh / h, h);
+    EXPECT_NEAR(c.transverse * kh / h, 1.0, 1e-5) << kh;
+    EXPECT_NEAR(c.longitudinal * kh / h, 0.5, 2e-3) << kh;
+  }
+  for (const double kh : {1e-3, 1e-2}) {
+    const LayerCompliance c = layerCompliance(kh / h, h);
+    EXPECT_NEAR(c.transverse / h, 1.0, 1e-4) << kh;
+    EXPECT_NEAR(c.longitudinal / h, 1.0, 1e-3) << kh;
+  }
+  EXPECT_NEAR(layerCompliance(0.25, h).transverse, std::tanh(1.0) / 0.25, 1e-12);
+  // Continuous across the shortcut at k h = 15.
+  EXPECT_NEAR(layerCompliance(14.999 / h, h).longitudinal / layerCompliance(15.001 / h, h).longitudinal,
+              1.0, 1e-3);
+  test::expectError([] { layerCompliance(0.0, 1.0); }, {"> 0"});
+}
+
+// A layer much thinner than a uniformly sheared patch is in simple shear under its middle:
+// u = q h / G. A layer much thicker than the patch is a half-space under it.
+TEST(SurfaceDisplacement, ALayerShearsSimplyWhenThinAndAsAHalfSpaceWhenThick) {
+  const double g = 0.1, q = 0.01, cell = 0.1;
+  const int n = 120;
+  cv::Mat1f qx = cv::Mat1f::zeros(n, n), qy = cv::Mat1f::zeros(n, n), ux, uy;
+  qx(cv::Rect(30, 30, 60, 60)).setTo(q);  // a 6 mm square
+  SurfaceDisplacement thin(n, n, cell, g, 0.5);
+  thin.solve(qx, qy, ux, uy);
+  EXPECT_NEAR(ux(60, 60) / (q * 0.5 / g), 1.0, 0.03);
+  // 4 h beyond the patch's edge the layer has nearly let go (a half-space would still move by
+  // 45 % of its own centre's displacement there): along the traction, and faster across it.
+  EXPECT_LT(std::abs(ux(60, 109)), 0.03 * ux(60, 60)) << "2 mm beyond the edge along x";
+  EXPECT_LT(std::abs(ux(109, 60)), 0.001 * ux(60, 60)) << "2 mm beyond the edge along y";
+  EXPECT_NEAR(uy(60, 60), 0.0, 1e-6);
+
+  cv::Mat1f disc = cv::Mat1f::zeros(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      if (std::hypot(i - 60, j - 60) * cell <= 1.0) disc(i, j) = static_cast<float>(q);
+    }
+  }
+  cv::Mat1f half_x, half_y;
+  SurfaceDisplacement half_space(n, n, cell, g);
+  half_space.solve(disc, qy, half_x, half_y);
+  SurfaceDisplacement thick(n, n, cell, g, 40.0);
+  thick.solve(disc, qy, ux, uy);
+  EXPECT_NEAR(ux(60, 60) / half_x(60, 60), 1.0, 0.03) << "h = 40 radii";
+  SurfaceDisplacement gel(n, n, cell, g, 2.0);
+  gel.solve(disc, qy, ux, uy);
+  EXPECT_LT(ux(60, 60), half_x(60, 60)) << "h = 2 radii: stiffer than a half-space";
+  EXPECT_GT(ux(60, 60), 0.5 * half_x(60, 60));
+  EXPECT_LT(ux(60, 110), 0.3 * half_x(60, 110)) << "5 mm away the layer has hardly moved";
+}
+
 TEST(SurfaceDisplacement, BadGridsAndTractionsAreErrors) {
   test::expectError([] { SurfaceDisplacement(0, 5, 0.1, 0.1); }, {"empty"});
   test::expectError([] { SurfaceDisplacement(5, 5, 0.0, 0.1); }, {"> 0"});
+  test::expectError([] { SurfaceDisplacement(5, 5, 0.1, 0.1, -1.0); }, {"thickness"});
   SurfaceDisplacement solver(4, 5, 0.1, 0.1);
   cv::Mat1f q = cv::Mat1f::zeros(5, 4), ux, uy;
   test::expectError([&] { solver.solve(q, q, ux, uy); }, {"4 x 5"});

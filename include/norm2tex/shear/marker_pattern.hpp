@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -36,9 +37,9 @@ class MarkerPattern {
   double radius_px_ = 0.0;    // the dot's radius
   double reach_px_ = 0.0;     // how far from its centre a dot darkens anything
   double darkness_ = 0.0;
-  // 1 - darkness * coverage, tabulated against the squared distance from the dot's centre in
-  // steps of kLutStep px^2 (a disc's blurred edge costs one lookup per pixel, not an erfc).
-  std::vector<float> transmission_;
+  // (1 - darkness * coverage) * 2^15, tabulated against the squared distance from the dot's
+  // centre in steps of 1/64 px^2 (a disc's blurred edge costs one lookup per pixel, not an erfc).
+  std::vector<std::int32_t> transmission_;
 };
 
 }  // namespace norm2tex

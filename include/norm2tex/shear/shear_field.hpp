@@ -32,8 +32,9 @@ struct ShearFrame {
 };
 
 /// The shear stage: from H_sensor, the normal force and the tangential load to the traction
-/// (solveContactTraction), the surface displacement (SurfaceDisplacement: Cerruti's half-space,
-/// nu = 1/2) and the markers (MarkerPattern). Holds its buffers; not thread-safe.
+/// (solveContactTraction), the surface displacement (SurfaceDisplacement: an incompressible gel
+/// of gel.thickness_mm bonded to its window) and the markers (MarkerPattern). Holds its buffers;
+/// not thread-safe.
 class ShearField {
  public:
   /// `cell_px` 0: cells of about kShearCellMm (8 px at a DIGIT's QVGA scale).

@@ -10,8 +10,8 @@
 namespace norm2tex {
 namespace {
 
-// Enough halvings to pin d* and the twist's stiffness to a few parts in 1e9 of their range.
-constexpr int kBisections = 32;
+// At most this many steps of d*'s search (Newton's converge in a handful).
+constexpr int kBisections = 40;
 
 struct ContactCell {
   int index;              // into the grid, row-major
@@ -34,15 +34,56 @@ void requireLoad(double normal_force_n, const ShearLoad& load, double friction) 
   }
 }
 
-// Smallest x in [0, high] with increasing(x) >= target, by bisection.
-template <typename F>
-double bisect(F increasing, double target, double high) {
-  double low = 0.0;
+// The d* at which the slip annulus carries `target` = Q / (mu k A):
+// S(d*) = sum of sqrt(d) - sqrt(max(d - d*, 0)) grows from 0 at d* = 0 to sum sqrt(d) at the
+// deepest d, convex in d*: from its first step on Newton's approaches the root from above,
+// and a bracket falls back to halving should a step leave it. A handful of sums instead of
+// bisection's thirty.
+double stickDepth(const std::vector<ContactCell>& cells, double target, double deepest) {
+  double low = 0.0, high = deepest;
+  double ds = 0.0;
   for (int i = 0; i < kBisections; ++i) {
-    const double mid = 0.5 * (low + high);
-    (increasing(mid) < target ? low : high) = mid;
+    double sum = 0.0, slope = 0.0;
+    for (const ContactCell& c : cells) {
+      const double rest = c.depth - ds;
+      if (rest > 0.0) {
+        const double root = std::sqrt(rest);
+        sum += c.root - root;
+        slope += 0.5 / root;
+      } else {
+        sum += c.root;
+      }
+    }
+    const double miss = sum - target;
+    if (std::abs(miss) <= 1e-10 * target) break;
+    (miss < 0.0 ? low : high) = ds;
+    const double newton = slope > 0.0 ? ds - miss / slope : high;
+    ds = (newton > low && newton < high) ? newton : 0.5 * (low + high);
   }
-  return 0.5 * (low + high);
+  return ds;
+}
+
+// The twist's stiffness kappa for which sum of min(kappa r, left) r = target (moment per cell
+// area). The sum is piecewise linear in kappa, bending where kappa = left / r: sorted by that
+// knee, it is solved exactly in one pass.
+double twistStiffness(const std::vector<double>& radius, const std::vector<double>& left,
+                      double target) {
+  std::vector<std::pair<double, size_t>> knees;
+  double linear = 0.0;  // sum of r^2 over cells still below their cap
+  for (size_t n = 0; n < radius.size(); ++n) {
+    if (radius[n] <= 0.0 || left[n] <= 0.0) continue;
+    knees.emplace_back(left[n] / radius[n], n);
+    linear += radius[n] * radius[n];
+  }
+  std::sort(knees.begin(), knees.end());
+  double capped = 0.0;  // sum of left r over cells at their cap
+  for (const auto& [knee, n] : knees) {
+    // Below this knee: moment(kappa) = kappa linear + capped.
+    if (knee * linear + capped >= target) return (target - capped) / linear;
+    linear -= radius[n] * radius[n];
+    capped += left[n] * radius[n];
+  }
+  return knees.empty() ? 0.0 : knees.back().first;
 }
 
 }  // namespace
@@ -94,12 +135,7 @@ ContactTraction solveContactTraction(const cv::Mat1f& penetration_mm, double cel
     out.gross_slip = true;
     d_star = deepest;
   } else if (q_mag > 0.0) {
-    const auto carried = [&](double ds) {
-      double sum = 0.0;
-      for (const ContactCell& c : cells) sum += c.root - std::sqrt(std::max(c.depth - ds, 0.0));
-      return friction * k * area * sum;
-    };
-    d_star = bisect(carried, q_mag, deepest);
+    d_star = stickDepth(cells, q_mag / (friction * k * area), deepest);
   }
   std::vector<double> translation(cells.size());
   for (size_t n = 0; n < cells.size(); ++n) {
@@ -114,33 +150,23 @@ ContactTraction solveContactTraction(const cv::Mat1f& penetration_mm, double cel
   double kappa = 0.0;
   bool twist_slides = false;
   if (moment > 0.0) {
-    double capacity = 0.0;  // the moment friction can still give, N mm
+    std::vector<double> left(cells.size());  // the friction the translation left, MPa
+    double capacity = 0.0;                    // the moment that friction can give, N mm
     double kappa_high = 0.0;
     for (size_t n = 0; n < cells.size(); ++n) {
       radius[n] = (cells[n].where - out.pressure_centre_mm).norm();
-      const double left = friction * k * cells[n].root - translation[n];
-      capacity += left * radius[n] * area;
-      if (radius[n] > 0.0) kappa_high = std::max(kappa_high, left / radius[n]);
+      left[n] = friction * k * cells[n].root - translation[n];
+      capacity += left[n] * radius[n] * area;
+      if (radius[n] > 0.0) kappa_high = std::max(kappa_high, left[n] / radius[n]);
     }
-    const auto given = [&](double kap) {
-      double sum = 0.0;
-      for (size_t n = 0; n < cells.size(); ++n) {
-        const double left = friction * k * cells[n].root - translation[n];
-        sum += std::min(kap * radius[n], left) * radius[n];
-      }
-      return sum * area;
-    };
     if (moment >= capacity) {
       twist_slides = true;
       out.gross_slip = true;
       kappa = kappa_high;
     } else {
-      kappa = bisect(given, moment, kappa_high);
+      kappa = twistStiffness(radius, left, moment / area);
     }
-    for (size_t n = 0; n < cells.size(); ++n) {
-      const double left = friction * k * cells[n].root - translation[n];
-      twist[n] = std::min(kappa * radius[n], left);
-    }
+    for (size_t n = 0; n < cells.size(); ++n) twist[n] = std::min(kappa * radius[n], left[n]);
   }
 
   const double turn = load.torque_nm >= 0.0 ? 1.0 : -1.0;

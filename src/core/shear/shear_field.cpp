@@ -46,8 +46,9 @@ ShearField::ShearField(const SensorModel& model, int cell_px) : model_(model) {
                                                                     model_.mm_per_pixel)));
   cell_mm_ = cell_px_ * model_.mm_per_pixel;
   grid_ = {(model_.cols + cell_px_ - 1) / cell_px_, (model_.rows + cell_px_ - 1) / cell_px_};
-  displacement_ = std::make_unique<SurfaceDisplacement>(grid_.height, grid_.width, cell_mm_,
-                                                        model_.shear.shear_modulus_mpa);
+  displacement_ = std::make_unique<SurfaceDisplacement>(
+      grid_.height, grid_.width, cell_mm_, model_.shear.shear_modulus_mpa,
+      model_.gel_thickness_mm);
   if (model_.markers.enabled) markers_ = std::make_unique<MarkerPattern>(model_);
   penetration_ = cv::Mat1f::zeros(grid_);
 }

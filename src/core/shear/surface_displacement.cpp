@@ -1,9 +1,12 @@
 #include "norm2tex/shear/surface_displacement.hpp"
 
+#include <cmath>
+#include <optional>
 #include <string>
 
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/shear/cerruti_kernel.hpp"
+#include "norm2tex/shear/layer_compliance.hpp"
 
 namespace norm2tex {
 namespace {
@@ -16,7 +19,7 @@ int offsetOf(int index, int padded) { return index < padded / 2 ? index : index 
 }  // namespace
 
 SurfaceDisplacement::SurfaceDisplacement(int rows, int cols, double cell_mm,
-                                         double shear_modulus_mpa)
+                                         double shear_modulus_mpa, double thickness_mm)
     : rows_(rows), cols_(cols), cell_mm_(cell_mm) {
   if (rows < 1 || cols < 1) {
     throw Error("SurfaceDisplacement: the grid is empty (" + std::to_string(rows) + " x " +
@@ -25,13 +28,31 @@ SurfaceDisplacement::SurfaceDisplacement(int rows, int cols, double cell_mm,
   if (!(cell_mm > 0.0) || !(shear_modulus_mpa > 0.0)) {
     throw Error("SurfaceDisplacement: cell size and shear modulus must be > 0");
   }
+  if (!(thickness_mm >= 0.0) || !std::isfinite(thickness_mm)) {
+    throw Error("SurfaceDisplacement: the layer's thickness must be >= 0 mm (0: a half-space)");
+  }
   padded_ = {cv::getOptimalDFTSize(2 * cols), cv::getOptimalDFTSize(2 * rows)};
+  std::optional<LayerCorrection> layer;
+  if (thickness_mm > 0.0) {
+    layer = layerCorrection(thickness_mm, std::hypot(padded_.width, padded_.height) * 0.5 * cell_mm);
+  }
+  const double area_over_g = cell_mm * cell_mm / shear_modulus_mpa;
   cv::Mat1f xx(padded_), xy(padded_), yy(padded_);
   for (int i = 0; i < padded_.height; ++i) {
     const double dy = offsetOf(i, padded_.height) * cell_mm;
     for (int j = 0; j < padded_.width; ++j) {
       const double dx = offsetOf(j, padded_.width) * cell_mm;
-      const LateralInfluence k = cerrutiCellInfluence(dx, dy, cell_mm, shear_modulus_mpa);
+      LateralInfluence k = cerrutiCellInfluence(dx, dy, cell_mm, shear_modulus_mpa);
+      if (layer) {
+        const double r = std::hypot(dx, dy);
+        double s = 0.0, d = 0.0;
+        layer->at(r, s, d);
+        // S I + D (2 r^ r^T - I), for the cell's traction at its centre.
+        const double cx = r > 0.0 ? dx / r : 0.0, cy = r > 0.0 ? dy / r : 0.0;
+        k.xx += area_over_g * (s + d * (2 * cx * cx - 1));
+        k.xy += area_over_g * (d * 2 * cx * cy);
+        k.yy += area_over_g * (s + d * (2 * cy * cy - 1));
+      }
       xx(i, j) = static_cast<float>(k.xx);
       xy(i, j) = static_cast<float>(k.xy);
       yy(i, j) = static_cast<float>(k.yy);
