@@ -34,6 +34,7 @@ _CORE_NAMES = (
     "MaterialConfig",
     "material_texture",
     "RenderedFrame",
+    "ShearLoad",
     "read_image",
     "calibrate_sensor",
     "compare_images",

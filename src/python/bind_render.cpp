@@ -74,14 +74,41 @@ struct RenderedFrame {
   py::array depth;         // (rows, cols) float32, metres
   py::array contact_mask;  // (rows, cols) uint8, 255 in contact
   bool textured = false;
+  py::object shear = py::none();          // (rows, cols, 2) float32, metres, or None
+  py::object markers = py::none();        // dict of (n, 2) float32 arrays, or None
+  py::object slip_fraction = py::none();  // float, or None
 };
 
-RenderedFrame copyFrame(const TactileFrame& frame) {
+py::array_t<float> pointsToNumpy(const std::vector<Marker>& markers,
+                                 cv::Point2f Marker::*field) {
+  py::array_t<float> out({static_cast<Py_ssize_t>(markers.size()), Py_ssize_t{2}});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < markers.size(); ++i) {
+    a(i, 0) = (markers[i].*field).x;
+    a(i, 1) = (markers[i].*field).y;
+  }
+  return out;
+}
+
+RenderedFrame copyFrame(const TactileFrame& frame, bool sheared) {
   RenderedFrame out;
   out.image = toNumpy(frame.image);
   out.depth = toNumpy(frame.depthMetres());
   out.contact_mask = toNumpy(frame.contact_mask);
   out.textured = frame.textured;
+  if (frame.shear) {
+    if (sheared) {
+      out.shear = toNumpy(frame.shear->displacementMetres(frame.image.size()));
+      out.slip_fraction = py::float_(frame.shear->slipFraction());
+    }
+    if (!frame.shear->markers.empty()) {
+      py::dict markers;
+      markers["rest_px"] = pointsToNumpy(frame.shear->markers, &Marker::rest_px);
+      markers["current_px"] = pointsToNumpy(frame.shear->markers, &Marker::current_px);
+      markers["displacement_mm"] = pointsToNumpy(frame.shear->markers, &Marker::displacement_mm);
+      out.markers = markers;
+    }
+  }
   return out;
 }
 
@@ -150,6 +177,14 @@ void bindRender(py::module& m) {
           [](const SensorModel& s) { return s.shading.slope_saturation; },
           [](SensorModel& s, double v) { s.shading.slope_saturation = v; },
           "the slope at which the calibrated shading's slope features saturate (0: none)")
+      .def_property(
+          "markers_enabled", [](const SensorModel& s) { return s.markers.enabled; },
+          [](SensorModel& s, bool on) { s.markers.enabled = on; },
+          "whether the gel carries the printed marker grid (the yaml's markers section)")
+      .def_property(
+          "shear_modulus_mpa", [](const SensorModel& s) { return s.shear.shear_modulus_mpa; },
+          [](SensorModel& s, double g) { s.shear.shear_modulus_mpa = g; },
+          "the gel's shear modulus G, MPa (how far a shear load moves its surface)")
       .def_readwrite("background_image", &SensorModel::background_image,
                      "no-contact frame (bgr image file); empty: the synthetic background")
       .def_property_readonly(
@@ -494,7 +529,36 @@ void bindRender(py::module& m) {
                     "(rows, cols) float32: the gel's deformation, metres")
       .def_readonly("contact_mask", &RenderedFrame::contact_mask,
                     "(rows, cols) uint8: 255 where the object touches the gel")
-      .def_readonly("textured", &RenderedFrame::textured, "whether the texture overlay ran");
+      .def_readonly("textured", &RenderedFrame::textured, "whether the texture overlay ran")
+      .def_readonly("shear", &RenderedFrame::shear,
+                    "(rows, cols, 2) float32: the gel surface's lateral displacement (x, y in the "
+                    "gel frame), metres; None when render() was given no shear load")
+      .def_readonly("markers", &RenderedFrame::markers,
+                    "dict of (n, 2) float32 arrays: rest_px and current_px (x = column, y = row), "
+                    "displacement_mm (gel frame); None when the sensor has no markers")
+      .def_readonly("slip_fraction", &RenderedFrame::slip_fraction,
+                    "fraction of the contact's area that slips (0 stick .. 1 sliding); None "
+                    "without a shear load");
+
+  py::class_<ShearLoad>(m, "ShearLoad",
+                        "The contact's tangential load on the gel (gel frame): what moves its "
+                        "surface sideways and carries the markers.")
+      .def(py::init([](const Eigen::Vector2d& force_n, double torque_nm,
+                       std::optional<double> friction) {
+             ShearLoad load;
+             load.force_n = force_n;
+             load.torque_nm = torque_nm;
+             load.friction = friction;
+             return load;
+           }),
+           py::arg("force_n") = Eigen::Vector2d::Zero(), py::arg("torque_nm") = 0.0,
+           py::arg("friction") = py::none())
+      .def_readwrite("force_n", &ShearLoad::force_n,
+                     "tangential force the object applies to the gel, (x, y), N")
+      .def_readwrite("torque_nm", &ShearLoad::torque_nm,
+                     "twisting moment about the gel's +z through the contact, N m (x towards y)")
+      .def_readwrite("friction", &ShearLoad::friction,
+                     "Coulomb coefficient gel-object; None: the sensor's shear.friction");
 
   py::class_<TactileRenderer>(
       m, "TactileRenderer",
@@ -515,23 +579,25 @@ void bindRender(py::module& m) {
       .def(
           "render",
           [](TactileRenderer& r, const py::object& object_in_gel, std::int64_t noise_seed,
-             std::optional<double> normal_force_n) {
+             std::optional<double> normal_force_n, std::optional<ShearLoad> shear) {
             const Eigen::Isometry3d pose = poseFromPython(object_in_gel, "object_in_gel");
             const TactileFrame* frame;
             {
               py::gil_scoped_release release;
-              frame = &r.render(pose, noise_seed, normal_force_n);
+              frame = &r.render(pose, noise_seed, normal_force_n, shear);
             }
-            return copyFrame(*frame);
+            return copyFrame(*frame, shear.has_value());
           },
           py::arg("object_in_gel"), py::arg("noise_seed") = -1,
-          py::arg("normal_force_n") = py::none(),
+          py::arg("normal_force_n") = py::none(), py::arg("shear") = py::none(),
           "Renders the object at `object_in_gel` (the object frame in the gel frame, metres: a "
           "4x4 matrix or (xyz, quaternion xyzw)); noise drawn from noise_seed (< 0: none). "
           "normal_force_n (N): the contact's force, which sets how much of the texture the gel "
           "follows when the sensor's conformity is on (None: the gel law's force for the press). "
-          "Returns a RenderedFrame. Raises norm2tex.Error for a non-finite pose or force, or no "
-          "object.")
+          "shear (a ShearLoad): the contact's tangential force and twist, which move the gel's "
+          "surface and its markers (frame.shear, frame.markers, frame.slip_fraction). "
+          "Returns a RenderedFrame. Raises norm2tex.Error for a non-finite pose, force or load, "
+          "or no object.")
       .def_property_readonly("background",
                              [](const TactileRenderer& r) { return toNumpy(r.shader().background()); },
                              "the no-contact frame without noise, (rows, cols, 3) uint8")

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -11,6 +12,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "cli_arguments.hpp"
 #include "contact_sheet.hpp"
@@ -25,6 +27,7 @@
 #include "norm2tex/render/tactile_renderer.hpp"
 #include "package_paths.hpp"
 #include "quiet_stderr.hpp"
+#include "shear_annotation.hpp"
 
 namespace {
 
@@ -39,9 +42,12 @@ norm2tex::cli::Program makeProgram() {
       "                       [--material NAME] [--sensor digit.yaml] [--background BG.png]\n"
       "                       [--seed S] [--no-noise] [--force-n F] [--conformity on|off]\n"
       "                       -o OUT.png [--depth-out D.tiff] [--mask-out M.png]\n"
-      "                       [--contact-stats]\n"
+      "                       [--contact-stats] [--shear \"FX,FY[,T]\"] [--friction MU]\n"
+      "                       [--markers on|off] [--markers-out M.csv] [--annotate GAIN]\n"
       "       norm2tex_render --sheet --mesh M --pose P [--presses 0.5,1,1.5]\n"
-      "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png",
+      "                       [--normal-map A.png,B.png,...] [--beta MM] ... -o SHEET.png\n"
+      "       norm2tex_render --shear-sheet --mesh M --pose P --loads \"FX,FY,T;...\"\n"
+      "                       [--annotate GAIN] ... -o SHEET.png",
       "Renders one DIGIT frame of a mesh pressed into the gel, with or without texture, or a\n"
       "contact sheet of several press depths and normal maps (--sheet).");
   program.add()  //
@@ -95,7 +101,27 @@ norm2tex::cli::Program makeProgram() {
        "A contact sheet (grid PNG): one column per press depth, one row without texture, then "
        "one row per normal map.")  //
       ("presses", po::value<std::string>()->value_name("0.5,1,1.5"),
-       "With --sheet: the press depths, mm (default 0.5,1.0,1.5).");
+       "With --sheet: the press depths, mm (default 0.5,1.0,1.5).")  //
+      ("shear", po::value<std::string>()->value_name("\"FX,FY[,T]\""),
+       "The contact's tangential load: the force the object applies to the gel along x and y "
+       "(N) and its twist about +z (N m, x towards y). Moves the gel's surface and its markers "
+       "(Cattaneo-Mindlin partial slip on an incompressible layer, docs/sensor.md); prints the "
+       "slip fraction and the largest marker displacement.")  //
+      ("friction", po::value<double>()->value_name("MU"),
+       "Coulomb friction gel-object for --shear (default: the sensor yaml's shear.friction).")  //
+      ("markers", po::value<std::string>()->value_name("on|off"),
+       "Overrides the sensor yaml's markers.enabled (its grid, or the built-in 9 rows x 7 "
+       "columns at 1.8 mm).")  //
+      ("markers-out", po::value<std::string>()->value_name("M.csv"),
+       "The markers: rest and current position (pixels), displacement (mm), one row each.")  //
+      ("annotate", po::value<double>()->value_name("GAIN"),
+       "Draw the contact's outline (white), its stick region (green) and each marker's motion "
+       "as an arrow GAIN times its length (yellow) over the frame.")  //
+      ("shear-sheet", po::bool_switch(),
+       "A sheet of one press under several loads (--loads), annotated (--annotate, default "
+       "5).")  //
+      ("loads", po::value<std::string>()->value_name("\"FX,FY,T;...\""),
+       "With --shear-sheet: the loads, one column each, as --shear takes them, ';' between.");
   return program;
 }
 
@@ -211,6 +237,52 @@ int renderSheet(const po::variables_map& args, const norm2tex::SensorModel& mode
   return 0;
 }
 
+// One press under each of --loads, annotated: where the contact sticks and how the markers move.
+int renderShearSheet(const po::variables_map& args, const norm2tex::SensorModel& model,
+                     std::shared_ptr<const norm2tex::TexturedMesh> mesh,
+                     const Eigen::Isometry3d& pose, std::optional<double> force_n,
+                     const std::string& output) {
+  if (!args.count("loads")) throw norm2tex::cli::UsageError("--shear-sheet needs --loads");
+  const std::vector<std::string> loads =
+      norm2tex::cli::splitLoads(args["loads"].as<std::string>());
+  if (loads.empty()) throw norm2tex::cli::UsageError("--loads: no load given");
+  const double gain = valueOr(args, "annotate", 5.0);
+  const std::int64_t seed =
+      args["no-noise"].as<bool>() ? -1 : valueOr<std::int64_t>(args, "seed", 0);
+  norm2tex::TactileRenderer renderer(model);
+  renderer.setObject(std::move(mesh));
+  std::vector<std::vector<cv::Mat3b>> tiles(1);
+  std::vector<std::string> labels;
+  for (const std::string& text : loads) {
+    norm2tex::ShearLoad load = norm2tex::cli::parseShearLoad(text, "--loads");
+    if (args.count("friction")) load.friction = args["friction"].as<double>();
+    const norm2tex::TactileFrame& frame = renderer.render(pose, seed, force_n, load);
+    cv::Mat3b tile = frame.image.clone();
+    norm2tex::cli::drawShearAnnotations(tile, *frame.shear, gain);
+    tiles[0].push_back(tile);
+    char label[96];
+    std::snprintf(label, sizeof(label), "%.3g,%.3g N %.3g Nmm: slip %.2f", load.force_n.x(),
+                  load.force_n.y(), load.torque_nm * 1e3, frame.shear->slipFraction());
+    labels.push_back(label);
+  }
+  char row[64];
+  std::snprintf(row, sizeof(row), "arrows x%.3g", gain);
+  norm2tex::writeImage(output, norm2tex::cli::makeContactSheet(tiles, {row}, labels));
+  std::printf("%s: 1 x %zu shear sheet\n", output.c_str(), loads.size());
+  return 0;
+}
+
+void writeMarkersCsv(const std::string& path, const norm2tex::ShearFrame& shear) {
+  std::ofstream out(path);
+  out << "rest_x_px,rest_y_px,current_x_px,current_y_px,displacement_x_mm,displacement_y_mm\n";
+  for (const norm2tex::Marker& m : shear.markers) {
+    out << m.rest_px.x << "," << m.rest_px.y << "," << m.current_px.x << "," << m.current_px.y
+        << "," << m.displacement_mm.x << "," << m.displacement_mm.y << "\n";
+  }
+  out.close();
+  if (!out) throw norm2tex::Error("--markers-out '" + path + "': cannot be written");
+}
+
 int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   const po::variables_map args = program.parse(argc, argv);
   if (!args.count("mesh")) throw norm2tex::cli::UsageError("missing --mesh");
@@ -224,6 +296,19 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
   }
   if (sheet && args["contact-stats"].as<bool>()) {
     throw norm2tex::cli::UsageError("--contact-stats measures one frame, not a --sheet");
+  }
+  const bool shear_sheet = args["shear-sheet"].as<bool>();
+  if (shear_sheet && (sheet || args.count("shear"))) {
+    throw norm2tex::cli::UsageError("--shear-sheet takes its loads from --loads, without --sheet "
+                                    "or --shear");
+  }
+  if (args.count("loads") && !shear_sheet) {
+    throw norm2tex::cli::UsageError("--loads only with --shear-sheet");
+  }
+  std::optional<norm2tex::ShearLoad> shear;
+  if (args.count("shear")) {
+    shear = norm2tex::cli::parseShearLoad(args["shear"].as<std::string>(), "--shear");
+    if (args.count("friction")) shear->friction = args["friction"].as<double>();
   }
   if (args.count("material") + args.count("normal-map") + args.count("atlas") > 1) {
     throw norm2tex::cli::UsageError("give one of --material, --normal-map and --atlas");
@@ -245,6 +330,16 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
     }
     model.conformity.enabled = conformity == "on";
   }
+  if (args.count("markers")) {
+    const std::string markers = args["markers"].as<std::string>();
+    if (markers != "on" && markers != "off") {
+      throw norm2tex::cli::UsageError("--markers: '" + markers + "'; valid: on, off");
+    }
+    model.markers.enabled = markers == "on";
+  }
+  if (args.count("markers-out") && !model.markers.enabled) {
+    throw norm2tex::cli::UsageError("--markers-out: the sensor has no markers (--markers on)");
+  }
   std::optional<double> force_n;
   if (args.count("force-n")) force_n = args["force-n"].as<double>();
   const auto pose = parsePose(args["pose"].as<std::string>(), valueOr(args, "press-mm", 0.0));
@@ -253,6 +348,7 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
     return loadMesh(mesh_spec, valueOr(args, "scale", 1.0));
   }();
   if (sheet) return renderSheet(args, model, mesh, output);
+  if (shear_sheet) return renderShearSheet(args, model, mesh, pose, force_n, output);
   std::shared_ptr<const norm2tex::HeightAtlas> atlas;
   double default_beta = 0.2;
   bool physical_scale = false;  // the atlas holds mm: beta is a gain
@@ -291,11 +387,18 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
       args["no-noise"].as<bool>() ? -1 : valueOr<std::int64_t>(args, "seed", 0);
 
   const auto start = std::chrono::steady_clock::now();
-  const norm2tex::TactileFrame& frame = renderer.render(pose, seed, force_n);
+  const norm2tex::TactileFrame& frame = renderer.render(pose, seed, force_n, shear);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
-  norm2tex::writeImage(output, frame.image);
+  if (args.count("annotate") && frame.shear) {
+    cv::Mat3b annotated = frame.image.clone();
+    norm2tex::cli::drawShearAnnotations(annotated, *frame.shear, args["annotate"].as<double>());
+    norm2tex::writeImage(output, annotated);
+  } else {
+    norm2tex::writeImage(output, frame.image);
+  }
+  if (args.count("markers-out")) writeMarkersCsv(args["markers-out"].as<std::string>(), *frame.shear);
   if (args.count("depth-out")) {
     norm2tex::writeImage(args["depth-out"].as<std::string>(), frame.depthMetres());
   }
@@ -325,6 +428,21 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
     for (const norm2tex::ConformityBand& band : c.bands) {
       std::printf(" %.2f (lambda %.3g mm)", band.followed_fraction, band.wavelength_mm);
     }
+    std::printf("\n");
+  }
+  if (shear) {
+    double largest = 0.0;
+    for (const norm2tex::Marker& m : frame.shear->markers) {
+      largest = std::max(largest, std::hypot(double{m.displacement_mm.x}, double{m.displacement_mm.y}));
+    }
+    double surface = 0.0;
+    cv::Mat1f magnitude;
+    cv::magnitude(frame.shear->ux_mm, frame.shear->uy_mm, magnitude);
+    cv::minMaxLoc(magnitude, nullptr, &surface);
+    std::printf("shear: %.2f of the contact slips%s; the surface moves up to %.3f mm",
+                frame.shear->slipFraction(), frame.shear->traction.gross_slip ? " (sliding)" : "",
+                surface);
+    if (!frame.shear->markers.empty()) std::printf(", the markers up to %.3f mm", largest);
     std::printf("\n");
   }
   return 0;

@@ -103,6 +103,38 @@ def test_a_ball_press_matches_hertz_geometry(sensor):
         assert float(frame.depth.max()) == pytest.approx(press_mm * 1e-3, rel=0.03)
 
 
+def test_a_shear_load_moves_the_gel_and_its_markers_from_python(sensor):
+    marked = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    marked.markers_enabled = True
+    ball = norm2tex.load_object_mesh("sphere:6")["mesh"]
+    renderer = norm2tex.TactileRenderer(marked)
+    renderer.set_object(ball)
+    pose = pose_matrix(0.0, 0.0, 0.006 - 1e-3, 0, 0, 0)
+    pressed = renderer.render(pose, normal_force_n=3.0)
+    assert pressed.shear is None and pressed.slip_fraction is None
+    assert pressed.markers is not None
+    np.testing.assert_array_equal(pressed.markers["current_px"], pressed.markers["rest_px"])
+    pushed = renderer.render(pose, normal_force_n=3.0, shear=norm2tex.ShearLoad((1.0, 0.0)))
+    assert pushed.shear.shape == (320, 240, 2) and pushed.shear.dtype == np.float32
+    centre = pushed.shear[160, 120]
+    assert centre[0] > 1e-5 and abs(centre[1]) < 0.05 * centre[0]  # metres, along the push
+    moved = pushed.markers["displacement_mm"]
+    assert moved.shape == (63, 2) and moved[:, 0].max() > 0.05 and moved[:, 0].min() >= 0.0
+    np.testing.assert_allclose(pushed.markers["current_px"] - pushed.markers["rest_px"],
+                               moved / marked.mm_per_pixel, atol=1e-3)
+    assert 0.0 < pushed.slip_fraction < 1.0
+    sliding = renderer.render(pose, normal_force_n=3.0, shear=norm2tex.ShearLoad((4.0, 0.0), 0.0, 1.0))
+    assert sliding.slip_fraction == 1.0  # 4 N beyond mu P = 3 N
+    # Without markers a shear load leaves the DIGIT frame as it was.
+    plain = norm2tex.TactileRenderer(sensor)
+    plain.set_object(ball)
+    np.testing.assert_array_equal(plain.render(pose, normal_force_n=3.0).image,
+                                  plain.render(pose, normal_force_n=3.0,
+                                               shear=norm2tex.ShearLoad((1.0, 0.5), 1e-3)).image)
+    with pytest.raises(norm2tex.Error, match="finite"):
+        renderer.render(pose, shear=norm2tex.ShearLoad((float("nan"), 0.0)))
+
+
 def test_errors_carry_the_cpp_message(sensor, cube):
     with pytest.raises(norm2tex.Error, match="/no/such/mesh.obj"):
         norm2tex.load_object_mesh("/no/such/mesh.obj")

@@ -197,6 +197,56 @@ TEST_F(RenderCli, ForceSetsTheTextureOnlyWithConformityOn) {
   EXPECT_FALSE(fs::exists(path("x.png")));
 }
 
+// --shear pushes the markers along the push (the CSV they are written to, and the image: a dot
+// where the shear carried it), prints the slip; the shear sheet has one column per load; bad
+// loads and options that do not go together are usage errors.
+TEST_F(RenderCli, ShearMovesTheMarkersAndBadLoadsAreUsageErrors) {
+  const std::string ball = "--mesh sphere:5 --pose \"0 0 0.005 0 0 0\" --press-mm 1 --force-n 3";
+  const CliRun run = render(ball + " --no-noise --markers on --shear 1,0 -o " + path("f.png") +
+                            " --markers-out " + path("m.csv"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("of the contact slips"), std::string::npos) << run.output;
+  std::ifstream csv(path("m.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "rest_x_px,rest_y_px,current_x_px,current_y_px,displacement_x_mm,"
+                  "displacement_y_mm");
+  int rows = 0;
+  double largest_x = 0.0, largest_y = 0.0;
+  while (std::getline(csv, line)) {
+    double v[6];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf", v, v + 1, v + 2, v + 3, v + 4,
+                          v + 5),
+              6)
+        << line;
+    EXPECT_GE(v[4], 0.0) << "every marker moves along +x, or not at all: " << line;
+    largest_x = std::max(largest_x, v[4]);
+    largest_y = std::max(largest_y, std::abs(v[5]));
+    ++rows;
+  }
+  EXPECT_EQ(rows, 63) << "the built-in 9 x 7 grid";
+  EXPECT_GT(largest_x, 0.05);
+  EXPECT_LT(largest_y, 0.2 * largest_x);
+  const CliRun sheet = render(ball + " --shear-sheet --loads \"0,0;1,0;0,0,0.002\" -o " +
+                              path("sheet.png"));
+  ASSERT_EQ(sheet.exit_code, 0) << sheet.output;
+  const cv::Mat tiles = cv::imread(path("sheet.png"));
+  EXPECT_GT(tiles.cols, 3 * 240) << "three columns";
+  EXPECT_LT(tiles.cols, 4 * 240);
+  for (const std::string& bad :
+       {std::string(" --shear 1"), std::string(" --shear 1,x"), std::string(" --shear 1,nan"),
+        std::string(" --markers maybe"), std::string(" --markers-out ") + path("m2.csv"),
+        std::string(" --loads \"1,0\""), std::string(" --shear-sheet"),
+        std::string(" --shear-sheet --shear 1,0 --loads \"1,0\"")}) {
+    const CliRun r = render(ball + bad + " -o " + path("bad.png"));
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(path("bad.png")));
+  const CliRun friction = render(ball + " --shear 1,0 --friction 0 -o " + path("bad.png"));
+  EXPECT_EQ(friction.exit_code, 1) << friction.output;
+  EXPECT_NE(friction.output.find("friction"), std::string::npos) << friction.output;
+}
+
 TEST_F(RenderCli, BadInputIsAOneLineErrorOrUsage) {
   const CliRun missing =
       render("--mesh " + path("nope.obj") + " --pose \"0 0 0 0 0 0\" -o " + path("x.png"));

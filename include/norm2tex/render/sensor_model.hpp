@@ -94,8 +94,8 @@ struct ConformityOptions {
 /// before the shading's difference is added, so they darken and move as real ones do.
 struct MarkerOptions {
   bool enabled = false;          ///< off: frames exactly as without markers
-  int rows = 7;                  ///< dots along the image's rows (down)
-  int cols = 9;                  ///< dots along the image's columns (right)
+  int rows = 9;                  ///< dots down the image (along +y); 9 x 7 fits a DIGIT's portrait
+  int cols = 7;                  ///< dots across it (along +x)
   double pitch_mm = 1.8;         ///< centre-to-centre spacing, both directions
   double dot_diameter_mm = 0.5;  ///< printed dot diameter
   /// Fraction of the light a dot takes at its centre, 0..1 (0.7: a dot shows 30 % of the
