@@ -268,6 +268,34 @@ void bindSim(py::module& m) {
              for (int i = 0; i < b.size(); ++i) out.append(toNumpy(b.gripper(i).frame(f).contact_mask));
              return py::module::import("numpy").attr("stack")(out);
            }, py::arg("finger"), "(N, rows, cols) uint8, 255 in contact")
+      .def("markers", [](const TactileGripperBatch& b, const std::string& finger) {
+             const Finger f = fingerFrom(finger);
+             const auto& first = b.gripper(0).frame(f).shear;
+             const Py_ssize_t n = b.size();
+             const Py_ssize_t count = first ? static_cast<Py_ssize_t>(first->markers.size()) : 0;
+             py::array_t<float> current({n, count, Py_ssize_t{2}}), moved({n, count, Py_ssize_t{2}});
+             py::array_t<double> slip(n);
+             for (int i = 0; i < b.size(); ++i) {
+               const auto& shear = b.gripper(i).frame(f).shear;
+               slip.mutable_at(i) = shear ? shear->slipFraction() : 0.0;
+               for (Py_ssize_t k = 0; k < count; ++k) {
+                 const Marker& m = shear->markers[k];
+                 current.mutable_at(i, k, 0) = m.current_px.x;
+                 current.mutable_at(i, k, 1) = m.current_px.y;
+                 moved.mutable_at(i, k, 0) = m.displacement_mm.x;
+                 moved.mutable_at(i, k, 1) = m.displacement_mm.y;
+               }
+             }
+             py::dict out;
+             out["current_px"] = current;
+             out["displacement_mm"] = moved;
+             out["slip_fraction"] = slip;
+             return out;
+           }, py::arg("finger"),
+           "One sensor's markers in every gripper: current_px (N, markers, 2) float32 (x = "
+           "column, y = row), displacement_mm (N, markers, 2) float32 (gel frame), and "
+           "slip_fraction (N,) of each contact (0 without shear). markers is 0 wide when the "
+           "sensor has none.")
       .def("background", [](const TactileGripperBatch& b, const std::string& finger) {
              return toNumpy(b.gripper(0).background(fingerFrom(finger)));
            }, py::arg("finger"), "the no-contact frame without noise, (rows, cols, 3) uint8")

@@ -28,7 +28,10 @@ pybind11::class_<Options>& bindTactileOptions(pybind11::class_<Options>& c) {
       .def_readwrite("friction", &Options::friction, "< 0: the material's")
       .def_readwrite("noise_seed", &Options::noise_seed, "< 0: no noise")
       .def_readwrite("noise_per_episode", &Options::noise_per_episode,
-                     "count the noise's frames from each reset (else from construction, as ROS)");
+                     "count the noise's frames from each reset (else from construction, as ROS)")
+      .def_readwrite("shear", &Options::shear,
+                     "render the gel's lateral motion from the physics' tangential force (always "
+                     "on when the sensor has markers)");
 }
 
 }  // namespace python

@@ -178,6 +178,33 @@ def test_bad_arguments_are_refused_clearly():
     env.close()
 
 
+def test_markers_carry_the_held_cubes_weight(tmp_path):
+    """A sensor with markers: the gels hold the cube against gravity, their surfaces move along
+    the weight's direction (world -z is one axis of each gel), the markers with them; with the
+    weight shared by two gels, both move by about as much."""
+    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    model.markers_enabled = True
+    marked = str(tmp_path / "marked.yaml")
+    model.save(marked)
+    env = GripperEnv(sensor=marked, markers=True, noise=False, material=None)
+    obs, _ = env.reset(seed=0)
+    assert env.observation_space.contains(obs)
+    left, right = obs["markers_left"], obs["markers_right"]
+    assert left.shape == (63, 2) and left.dtype == np.float32
+    moved = [np.abs(m).max() for m in (left, right)]
+    assert min(moved) > 1e-3, moved  # mm: the gels carry the cube's weight
+    # Along one axis of the gel: the weight's direction, not the other.
+    for m in (left, right):
+        along = np.argmax(np.abs(m).max(axis=0))
+        assert np.abs(m[:, 1 - along]).max() < 0.5 * np.abs(m[:, along]).max()
+    assert moved[0] == pytest.approx(moved[1], rel=0.3)
+    env.close()
+    with pytest.raises(ValueError, match="marker grid"):
+        GripperEnv(markers=True, noise=False)
+    with pytest.raises(ValueError, match="inprocess"):
+        GripperEnv(markers=True, backend="ros")
+
+
 def test_local_spaces_behave_like_gymnasiums():
     box = spaces.LocalBox(0, 255, shape=(4, 3), dtype=np.uint8, seed=1)
     assert box.contains(box.sample())

@@ -65,6 +65,10 @@ class GripperVectorEnv(spaces.EnvBase):
       downscale: integer factor, images averaged over factor x factor pixels.
       depth: also "depth_left"/"depth_right" (float32 metres, gel deformation).
       force: also "force": normal force of each gel (2,) float32, N.
+      markers: also "markers_left"/"markers_right": every marker's displacement on the gel
+        (markers, 2) float32, mm (gel frame x, y), carried by the gel's lateral motion under the
+        physics' tangential force; needs a sensor with a marker grid (its yaml's markers:) and
+        the in-process backend.
       frames_per_step: sensor frames per step.
       max_episode_steps: truncation (None: never).
       backend: "inprocess" or "ros" (num_envs 1; ros_options are RosBackend's arguments).
@@ -89,6 +93,7 @@ class GripperVectorEnv(spaces.EnvBase):
         downscale=1,
         depth=False,
         force=True,
+        markers=False,
         frames_per_step=1,
         max_episode_steps=None,
         backend="inprocess",
@@ -113,6 +118,9 @@ class GripperVectorEnv(spaces.EnvBase):
         self.downscale = int(downscale)
         self.with_depth = bool(depth)
         self.with_force = bool(force)
+        self.with_markers = bool(markers)
+        if self.with_markers and backend != "inprocess":
+            raise ValueError("markers=True needs backend='inprocess'")
         self.frames_per_step = int(frames_per_step)
         self.max_episode_steps = max_episode_steps
         self.render_mode = render_mode
@@ -223,6 +231,14 @@ class GripperVectorEnv(spaces.EnvBase):
                 entries.append(("depth_" + f, spaces.Box(0.0, 0.01, shape=depth, dtype=np.float32)))
         if self.with_force:
             entries.append(("force", spaces.Box(0.0, np.inf, shape=(2,), dtype=np.float32)))
+        if self.with_markers:
+            count = self.backend.markers("left").shape[1]
+            if count == 0:
+                raise ValueError("markers=True needs a sensor with a marker grid (its yaml's "
+                                 "markers: enabled: true), e.g. config/gelsight_mini.yaml")
+            for f in FINGERS:
+                entries.append(("markers_" + f, spaces.Box(-np.inf, np.inf, shape=(count, 2),
+                                                           dtype=np.float32)))
         return spaces.Dict(dict(entries))
 
     def _batched(self, space):
@@ -274,6 +290,9 @@ class GripperVectorEnv(spaces.EnvBase):
                 ).astype(np.float32)
         if self.with_force:
             obs["force"] = state["normal_force_n"].astype(np.float32)
+        if self.with_markers:
+            for f in FINGERS:
+                obs["markers_" + f] = self.backend.markers(f)
         return obs
 
     @staticmethod

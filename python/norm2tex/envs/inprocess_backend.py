@@ -23,6 +23,7 @@ class InProcessBackend:
       step_one(i, mode, value, frames=1)  # gripper i alone (the others stand still)
       images(finger) -> (N, rows, cols, 3) uint8     finger: "left" / "right"
       depths(finger) -> (N, rows, cols) float32 m
+      markers(finger) -> (N, markers, 2) float32 mm    (in-process only)
       background(finger) -> (rows, cols, 3) uint8    (no contact, no noise)
       state() -> dict of arrays: opening, commanded_opening (N,), normal_force_n,
                  penetration_m, in_contact (N, 2), dropped (N,), frame (N,)
@@ -119,6 +120,10 @@ class InProcessBackend:
 
     def depths(self, finger):
         return self.batch.depths(finger)
+
+    def markers(self, finger):
+        """(N, markers, 2) float32: each marker's displacement on the gel, mm (0 wide: none)."""
+        return self.batch.markers(finger)["displacement_mm"]
 
     def background(self, finger):
         return self._backgrounds[finger]

@@ -7,6 +7,7 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/sim/contact_shear_load.hpp"
 #include "sim/tactile_options.hpp"
 
 namespace norm2tex {
@@ -97,8 +98,12 @@ void TactileGripper::render(Finger finger) {
       options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
   // The gel's normal force from the physics: it sets how much of the texture the gel follows
   // (GelConformity) when the sensor's conformity is on.
-  frames_[index(finger)] = &renderers_[index(finger)]->render(objectInGel(finger), noise_seed,
-                                                              sim_->contact(finger).normal_force_n);
+  TactileRenderer& renderer = *renderers_[index(finger)];
+  const GelContactState& contact = sim_->contact(finger);
+  std::optional<ShearLoad> shear;
+  if (options_.shear || renderer.model().markers.enabled) shear = shearLoadOf(contact, friction());
+  frames_[index(finger)] =
+      &renderer.render(objectInGel(finger), noise_seed, contact.normal_force_n, shear);
 }
 
 Eigen::Isometry3d TactileGripper::objectInGel(Finger finger) const {

@@ -8,6 +8,7 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
+#include "norm2tex/sim/contact_shear_load.hpp"
 #include "norm2tex/sim/tactile_gripper.hpp"
 #include "sim/tactile_options.hpp"
 
@@ -100,8 +101,11 @@ void TactileHand::render(int sensor) {
       options_.noise_per_episode ? frameIndex() - episode_first_frame_ : frameIndex();
   const std::int64_t noise_seed =
       options_.noise_seed < 0 ? -1 : options_.noise_seed * 1000003 + frame;
-  frames_[sensor] = &renderers_[sensor]->render(objectInGel(sensor), noise_seed,
-                                                sim_->contact(sensor).normal_force_n);
+  TactileRenderer& renderer = *renderers_[sensor];
+  const GelContactState& contact = sim_->contact(sensor);
+  std::optional<ShearLoad> shear;
+  if (options_.shear || renderer.model().markers.enabled) shear = shearLoadOf(contact, friction());
+  frames_[sensor] = &renderer.render(objectInGel(sensor), noise_seed, contact.normal_force_n, shear);
 }
 
 void TactileHand::renderAll() {
