@@ -188,7 +188,8 @@ SUBSTITUTIONS = {
     "docs/materials.md": {"NORMAL.png": "normal.png", "IN.stl": WSG50_DIGIT_MESH,
                           "DIR": "variants", "GALLERY.png": "gallery.png"},
     "docs/sensor.md": {"M": "sphere:5", '"x y z roll pitch yaw"': '"0 0 0.005 0 0 0"',
-                       "P": '"0 0 0.005 0 0 0"', "OUT.png": "out.png", "SHEET.png": "sheet.png"},
+                       "P": '"0 0 0.005 0 0 0"', "OUT.png": "out.png", "SHEET.png": "sheet.png",
+                       '"FX,FY,T;..."': '"0,0,0;1,0,0"'},
     "docs/texture.md": {"NORMAL_MAP": "my_normal.png", "OUT.tiff": "out.tiff"},
 }
 
