@@ -16,6 +16,7 @@
 #include "norm2tex/calibrate/background_noise.hpp"
 #include "norm2tex/calibrate/ball_press.hpp"
 #include "norm2tex/calibrate/calibration_report.hpp"
+#include "norm2tex/calibrate/marker_detection.hpp"
 #include "norm2tex/calibrate/press_detection.hpp"
 #include "norm2tex/calibrate/press_labels.hpp"
 #include "norm2tex/calibrate/press_refinement.hpp"
@@ -25,6 +26,7 @@
 #include "norm2tex/render/digit_shader.hpp"
 #include "norm2tex/render/digit_shader_noise.hpp"
 #include "norm2tex/render/gel_model.hpp"
+#include "norm2tex/shear/marker_pattern.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {
@@ -211,6 +213,57 @@ TEST(Calibration, RoundTripRecoversTheScaleAndReproducesHeldOutPresses) {
   EXPECT_GE(search.profile.size(), 8u);
   EXPECT_LE(search.range_min, truth.mm_per_pixel);
   EXPECT_GE(search.range_max, truth.mm_per_pixel);
+}
+
+// A marker gel: its dots are found on the background (grid, pitch, diameter), filled in before
+// the fit, and the calibration reproduces the held-out presses as well as without them.
+TEST(Calibration, AMarkerGelsDotsAreMeasuredAndMaskedOutOfTheFit) {
+  SensorModel truth = makeDigitSensorModel();
+  truth.markers.enabled = true;
+  truth.markers.rows = 9;
+  truth.markers.cols = 7;
+  truth.markers.pitch_mm = 1.6;
+  truth.markers.dot_diameter_mm = 0.45;
+  truth.markers.darkness = 0.6;
+  const cv::Mat3b smooth = makeSyntheticBackground(truth.imageSize());
+  const DigitShader shader(truth, smooth, BackgroundSource::kSynthetic);
+  const MarkerPattern pattern(truth);
+  std::vector<Marker> rest;
+  for (const cv::Point2f& p : pattern.restPx()) rest.push_back({p, p, {0, 0}});
+  const auto marked = [&](cv::Mat3b frame) {
+    pattern.draw(frame, rest);  // a pure press leaves the markers where they are
+    return frame;
+  };
+  CalibrationInput input;
+  const cv::Mat1f flat(truth.rows, truth.cols, 0.0f);
+  input.backgrounds.push_back({"bg0", marked(shader.shade(flat, 100))});
+  int seed = 0;
+  for (const PressCircle& circle : spreadPresses(truth, 10)) {
+    input.presses.push_back(
+        {"press" + std::to_string(seed), marked(renderPress(truth, shader, circle, seed))});
+    ++seed;
+  }
+  input.ball_diameter_mm = 2.0 * kBallRadiusMm;
+  input.mm_per_pixel = truth.mm_per_pixel;
+  const CalibrationResult result = calibrateSensor(makeDigitSensorModel(), input);
+  ASSERT_TRUE(result.markers.found());
+  EXPECT_EQ(result.markers.centres_px.size(), 63u);
+  const MarkerOptions& m = result.model.markers;
+  EXPECT_TRUE(m.enabled);
+  EXPECT_EQ(m.rows, 9);
+  EXPECT_EQ(m.cols, 7);
+  EXPECT_NEAR(m.pitch_mm, 1.6, 0.02);
+  EXPECT_NEAR(m.dot_diameter_mm, 0.45, 0.05);
+  EXPECT_NEAR(m.darkness, 0.6, 0.1);
+  EXPECT_NEAR(m.offset_mm[0], 0.0, 0.03);
+  EXPECT_NEAR(m.offset_mm[1], 0.0, 0.03);
+  std::printf("with markers: held-out variance explained %.3f\n",
+              result.held_out.variance_explained);
+  EXPECT_GE(result.held_out.variance_explained, 0.95);
+  // The background kept is the gel's without its dots: no dot left darker than the threshold.
+  EXPECT_FALSE(detectMarkers(result.background).found());
+  // A DIGIT's real background has no markers.
+  EXPECT_FALSE(detectMarkers(cv::imread(NORM2TEX_SOURCE_DIR "/config/digit_s09_background.png")).found());
 }
 
 NamedFrame fixtureFrame(int index) {

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "norm2tex/calibrate/fit_quality.hpp"
+#include "norm2tex/calibrate/marker_detection.hpp"
 #include "norm2tex/calibrate/press_detection.hpp"
 #include "norm2tex/calibrate/press_frame_comparison.hpp"
 #include "norm2tex/calibrate/shading_fit.hpp"
@@ -50,6 +51,10 @@ struct CalibrationResult {
   /// Each press's render (background + simulated difference) against its frame as captured, in
   /// the order of the input: SSIM, SSIM inside the contact, PSNR, mean |diff|.
   std::vector<PressFrameComparison> held_out_frames, training_frames;
+  /// A marker gel's dots found on the backgrounds (none on a DIGIT): they are filled in from
+  /// their surroundings in every frame before the fit (so the fit, the comparisons and
+  /// `background` are of the gel without them), and their layout is model.markers.
+  DetectedMarkers markers;
 };
 
 /// Minimum number of presses: 3 to fit, 1 to hold out.
@@ -63,7 +68,9 @@ constexpr int kMinCalibrationPresses = 4;
 /// unseen by the shading fit), refits, renders the held-out presses with DigitShader at the
 /// fitted geometry and compares (compareWithReal), compares every press's rendered frame with
 /// its real one (held_out_frames, training_frames), and measures the background noise
-/// (measureBackgroundNoise). `base` gives the image size and the parts not
+/// (measureBackgroundNoise). A marker gel's dots (detectMarkers on the mean background) are
+/// filled in first in every frame and their layout measured (result.markers, model.markers).
+/// `base` gives the image size and the parts not
 /// fitted (gel smoothing, camera, LEDs). Throws Error naming the frame for frames of another
 /// size or orientation than `base`, presses it cannot find, a ball that cannot make the
 /// contacts, or fewer than kMinCalibrationPresses presses.

@@ -68,6 +68,15 @@ std::vector<std::string> describeFitQuality(const CalibrationResult& r) {
     lines.push_back("fitted presses' " +
                     describeFrameMedians(r.training_frames, &PressFrameComparison::similarity));
   }
+  if (r.markers.found()) {
+    const MarkerOptions& m = r.model.markers;
+    lines.push_back(format("markers: %.0f found, a %.0f x %.0f grid at %.3f mm, dots %.3f mm "
+                           "taking %.2f of the light",
+                           static_cast<double>(r.markers.centres_px.size()), m.rows, m.cols,
+                           m.pitch_mm, m.dot_diameter_mm, m.darkness) +
+                    format(", centred at (%.3f, %.3f) mm; filled in before the fit",
+                           m.offset_mm[0], m.offset_mm[1]));
+  }
   return lines;
 }
 

@@ -203,9 +203,35 @@ void renderAndCompare(const CalibrationInput& input, std::vector<PressObservatio
 
 }  // namespace
 
-CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& input,
+namespace {
+
+// The input with a marker gel's dots filled in from their surroundings, in every frame, so the
+// shading is fitted and judged on the gel alone; `markers`: the dots found on the mean
+// background (none on a DIGIT: the input is returned as it is).
+CalibrationInput markerFreeInput(const CalibrationInput& input, DetectedMarkers& markers) {
+  cv::Mat3b background;
+  meanBackground(input.backgrounds).convertTo(background, CV_8U);
+  markers = detectMarkers(background);
+  if (!markers.found()) return input;
+  // The dots are filled from a ring about their own radius wide around them.
+  const double sigma = std::max(1.5, 0.5 * markers.diameter_px);
+  CalibrationInput clean = input;
+  for (NamedFrame& frame : clean.backgrounds) {
+    frame.image = withoutMarkers(frame.image, markers.mask, sigma);
+  }
+  for (NamedFrame& frame : clean.presses) {
+    frame.image = withoutMarkers(frame.image, markers.mask, sigma);
+  }
+  return clean;
+}
+
+}  // namespace
+
+CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInput& raw_input,
                                   const CalibrationOptions& options) {
-  checkInput(base, input, kMinCalibrationPresses, "calibration");
+  checkInput(base, raw_input, kMinCalibrationPresses, "calibration");
+  DetectedMarkers markers;
+  const CalibrationInput input = markerFreeInput(raw_input, markers);
   if (!(options.holdout_fraction > 0.0 && options.holdout_fraction < 1.0)) {
     throw Error("holdout fraction must be in (0, 1)");
   }
@@ -265,11 +291,19 @@ CalibrationResult calibrateSensor(const SensorModel& base, const CalibrationInpu
   // ones' frames are compared too (one render each, cheap beside the fit).
   renderAndCompare(input, std::move(held_out), training, held_out_index, training_index, labelled,
                    ball_radius_mm, result);
+  if (markers.found()) {
+    // The layout measured on the background, at the fitted scale; the background kept is the
+    // marker-free one (the renderer draws the markers where the gel carries them).
+    result.model.markers = markers.options(result.model, result.model.mm_per_pixel);
+    result.markers = std::move(markers);
+  }
   return result;
 }
 
-CalibrationResult judgeSensor(const SensorModel& fitted, const CalibrationInput& input) {
-  checkInput(fitted, input, 1, "judging a sensor");
+CalibrationResult judgeSensor(const SensorModel& fitted, const CalibrationInput& raw_input) {
+  checkInput(fitted, raw_input, 1, "judging a sensor");
+  DetectedMarkers markers;
+  const CalibrationInput input = markerFreeInput(raw_input, markers);
   if (input.mm_per_pixel && std::abs(*input.mm_per_pixel - fitted.mm_per_pixel) >
                                 1e-9 * fitted.mm_per_pixel) {
     std::ostringstream message;
