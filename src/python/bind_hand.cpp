@@ -323,6 +323,21 @@ void bindHand(py::module& m) {
              for (int i = 0; i < h.sensorCount(); ++i) out[py::str(h.sensorName(i))] = toNumpy(h.frame(i).image);
              return out;
            }, "every sensor's latest image by name")
+      .def("markers", [](const TactileHand& h) {
+             py::dict out;
+             for (int i = 0; i < h.sensorCount(); ++i) {
+               const auto& shear = h.frame(i).shear;
+               const Py_ssize_t count = shear ? static_cast<Py_ssize_t>(shear->markers.size()) : 0;
+               py::array_t<float> moved({count, Py_ssize_t{2}});
+               for (Py_ssize_t k = 0; k < count; ++k) {
+                 moved.mutable_at(k, 0) = shear->markers[k].displacement_mm.x;
+                 moved.mutable_at(k, 1) = shear->markers[k].displacement_mm.y;
+               }
+               out[py::str(h.sensorName(i))] = moved;
+             }
+             return out;
+           }, "every sensor's markers' displacement on its gel by name, (markers, 2) float32 mm "
+              "(gel frame); 0 wide for a sensor without markers")
       .def("depth", [](const TactileHand& h, const py::object& sensor) {
              return toNumpy(h.frame(sensorFrom(h.sim(), sensor)).depthMetres());
            }, py::arg("sensor"), "(rows, cols) float32 gel deformation, metres")

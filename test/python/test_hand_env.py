@@ -185,6 +185,34 @@ def test_closing_the_wsg_changes_both_images_where_it_presses():
         np.testing.assert_array_equal(obs[name], obs0[name])
 
 
+def test_markers_of_the_wsg_stay_put_under_a_squeeze_on_a_resting_cube(tmp_path):
+    """The WSG-50 squeezing the cube that rests on the table: the gels press it (10 N), the
+    table carries its weight, so the tangential load is a few mN and the markers move by
+    micrometres, on average along that load; observed per sensor. A sensor without markers is
+    refused."""
+    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    model.markers_enabled = True
+    marked = str(tmp_path / "marked.yaml")
+    model.save(marked)
+    env = wsg_env(sensor=marked, markers=True)
+    obs, info = env.reset(seed=0)
+    assert env.observation_space.contains(obs)
+    for _ in range(9):
+        obs, reward, terminated, truncated, info = env.step(np.array([-0.016, 0.016], np.float32))
+    for name in ("digit_left", "digit_right"):
+        moved = obs[name + "_markers"]
+        assert moved.shape == (63, 2) and moved.dtype == np.float32
+        contact = info["contacts"][name]
+        assert contact["in_contact"]
+        shear = np.asarray(contact["shear_force_n"][:2])
+        assert 1e-4 < np.linalg.norm(shear) < 0.1, shear  # N: the table holds the cube
+        mean = moved.mean(axis=0)
+        assert np.dot(mean, shear) / (np.linalg.norm(mean) * np.linalg.norm(shear)) > 0.95
+        assert np.abs(moved).max() < 0.01  # mm
+    with pytest.raises(ValueError, match="marker grid"):
+        wsg_env(markers=True)
+
+
 def test_delta_actions_move_from_the_joint_positions():
     env = wsg_env(action="delta", max_delta=0.005, frames_per_step=30)  # 0.5 s: 10 mm possible
     obs, _ = env.reset(seed=0)

@@ -95,6 +95,9 @@ class HandEnv(spaces.EnvBase):
         material's) and Coulomb friction (None: the material's).
       noise: image noise on (its seed drawn from reset's seed) or off. The default sensor's
         captured background carries the real DIGIT's noise and gets none on top.
+      markers: also "<sensor>_markers" for every sensor: its markers' displacement on the gel,
+        (markers, 2) float32 mm (gel frame); needs sensors with a marker grid and the in-process
+        backend.
       frames_per_step: sensor frames per step.
       max_steps: truncation (None: never).
       backend: "inprocess", or "ros": a running hand_sim.launch mode:=synchronous
@@ -122,6 +125,7 @@ class HandEnv(spaces.EnvBase):
         noise=True,
         action="position",
         max_delta=None,
+        markers=False,
         frames_per_step=1,
         max_steps=None,
         reward=None,
@@ -139,6 +143,9 @@ class HandEnv(spaces.EnvBase):
             raise ValueError("reward = %r; valid: None or a callable reward(obs, info)" % (reward,))
         if backend not in ("inprocess", "ros"):
             raise ValueError("backend = %r; valid: inprocess, ros" % (backend,))
+        if markers and backend != "inprocess":
+            raise ValueError("markers=True needs backend='inprocess'")
+        self.with_markers = bool(markers)
         self.action_kind = action
         self.frames_per_step = int(frames_per_step)
         self.max_steps = None if max_steps is None else int(max_steps)
@@ -193,6 +200,14 @@ class HandEnv(spaces.EnvBase):
         entries.append((JOINTS_KEY, spaces.Box((self.joint_lower - 1e-6).astype(np.float32),
                                                (self.joint_upper + 1e-6).astype(np.float32),
                                                shape=(n,), dtype=np.float32)))
+        if self.with_markers:
+            for name, moved in b.markers().items():
+                if moved.shape[0] == 0:
+                    b.close()
+                    raise ValueError("markers=True: sensor %s has no marker grid (its yaml's "
+                                     "markers: enabled: true)" % name)
+                entries.append((name + "_markers", spaces.Box(-np.inf, np.inf, shape=moved.shape,
+                                                              dtype=np.float32)))
         self.observation_space = spaces.Dict(dict(entries))
         self._rng = np.random.default_rng()
         self._steps = 0
@@ -254,6 +269,9 @@ class HandEnv(spaces.EnvBase):
         images = self.backend.images()
         obs = {name: images[name] for name in self.sensor_names}
         obs[JOINTS_KEY] = self._state["joint_positions"].astype(np.float32)
+        if self.with_markers:
+            for name, moved in self.backend.markers().items():
+                obs[name + "_markers"] = moved
         return obs
 
     def _info(self, clipped=()):

@@ -76,6 +76,10 @@ class HandInProcessBackend:
     def images(self):
         return self.hand.images()
 
+    def markers(self):
+        """{sensor: (markers, 2) float32 mm}: each marker's displacement on its gel."""
+        return self.hand.markers()
+
     def background(self, sensor):
         return self.hand.background(sensor)
 
