@@ -31,14 +31,24 @@ using ros_params::packageFile;
 using ros_params::readParam;
 using ros_params::text;
 
-/// A message's pose; throws Error for one that is not finite or whose quaternion is not unit
-/// length (within 1e-3: a hand-typed one), naming `what`.
+/// A message's pose; throws Error for one whose position or quaternion is not finite or whose
+/// quaternion is not unit length (within 1e-3: a hand-typed one), naming `what` and the values.
 Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, const std::string& what) {
   const Eigen::Quaterniond q(pose.orientation.w, pose.orientation.x, pose.orientation.y,
                              pose.orientation.z);
   const Eigen::Vector3d p(pose.position.x, pose.position.y, pose.position.z);
-  if (!p.allFinite() || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
-    throw Error(what + " is not a finite pose with a unit quaternion");
+  if (!p.allFinite()) {
+    std::ostringstream out;
+    out << what << ": position (" << p.x() << ", " << p.y() << ", " << p.z() << ") is not finite";
+    throw Error(out.str());
+  }
+  if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
+    std::ostringstream out;
+    out << what << ": orientation (x " << q.x() << ", y " << q.y() << ", z " << q.z() << ", w "
+        << q.w() << ") is not a unit quaternion";
+    if (q.coeffs().allFinite()) out << " (length " << q.norm() << ")";
+    out << "; no rotation is (x 0, y 0, z 0, w 1)";
+    throw Error(out.str());
   }
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
   out.linear() = q.normalized().toRotationMatrix();
@@ -357,14 +367,21 @@ bool HandSimRos::onStep(HandStep::Request& request, HandStep::Response& response
     ROS_WARN("hand_sim: %s", response.message.c_str());
     return true;
   }
-  if (!request.targets.name.empty()) {
-    try {
+  // Checked before anything is set: a refusal changes nothing.
+  std::optional<Eigen::Isometry3d> base;
+  try {
+    if (request.set_base_pose) base = fromPoseMsg(request.base_pose, "base_pose");
+    if (!request.targets.name.empty()) {
       warnClamped(sim_->setJointTargets(request.targets.name, request.targets.position));
-    } catch (const Error& e) {
-      response.message = std::string("~step refused, nothing changed: ") + e.what();
-      ROS_WARN("hand_sim: %s", response.message.c_str());
-      return true;
     }
+    // Before this step's physics, reached over its first frame as a ~base_pose message is, but
+    // ordered with the frames. setBasePose takes every pose fromPoseMsg gave: once the targets
+    // are set, nothing is refused.
+    if (base) sim_->setBasePose(*base, frame_period_ns_ * 1e-9);
+  } catch (const Error& e) {
+    response.message = std::string("~step refused, nothing changed: ") + e.what();
+    ROS_WARN("hand_sim: %s", response.message.c_str());
+    return true;
   }
   response.missing_images = 0;
   try {

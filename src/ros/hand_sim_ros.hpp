@@ -44,7 +44,8 @@ HandSimParams readHandSimParams(const ros::NodeHandle& private_nh);
 /// /robot_description. Commands: ~joint_command (trajectory_msgs/JointTrajectory),
 /// ~joint_targets (sensor_msgs/JointState), ~base_pose (geometry_msgs/PoseStamped in "world"),
 /// gripper/command (GripperCommand, for a hand yaml with gripper joints). Services ~reset, and
-/// ~step in synchronous mode.
+/// ~step in synchronous mode (with targets and a base pose of its own, ordered with its frames
+/// where a topic's message is not).
 class HandSimRos {
  public:
   /// Throws Error (bad parameter, unreadable hand, URDF, mesh, scene) before advertising.

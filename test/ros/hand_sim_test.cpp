@@ -1,13 +1,16 @@
 // rostest of hand_sim.launch with a real master (hand_sim.test: TACTO's WSG-50 over a cube,
-// synchronous): lock-step images per sensor, a grasp by JointTrajectory, the robot's state as
-// a simulator publishes it, refusals. Waits on conditions with deadlines, never sleeps.
+// synchronous): lock-step images per sensor, a grasp by JointTrajectory, a lift by base poses sent
+// with ~step, the robot's state as a simulator publishes it, refusals. Waits on conditions with
+// deadlines, never sleeps.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <limits>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <geometry_msgs/PoseStamped.h>
@@ -57,12 +60,21 @@ struct Hand {
     EXPECT_TRUE(
         waitFor([&] { return left.getNumPublishers() > 0 && right.getNumPublishers() > 0; }, 60.0));
   }
-  norm2tex::HandStep::Response stepFrames(unsigned frames) {
+  /// `frames` frames; with `base`, the hand's root is moved there by this step's request.
+  norm2tex::HandStep::Response stepFrames(unsigned frames,
+                                          const std::optional<geometry_msgs::Pose>& base = {}) {
     norm2tex::HandStep srv;
     srv.request.frames = frames;
+    srv.request.set_base_pose = base.has_value();
+    if (base) srv.request.base_pose = *base;
     EXPECT_TRUE(step.call(srv));
     EXPECT_TRUE(srv.response.success) << srv.response.message;
     return srv.response;
+  }
+  /// The hand's root in the world at a frame's stamp.
+  geometry_msgs::Transform base(const ros::Time& stamp) {
+    return buffer.lookupTransform("world", "gripper_base_link", stamp, ros::Duration(10.0))
+        .transform;
   }
   void send(const trajectory_msgs::JointTrajectory& t) {
     ASSERT_TRUE(waitFor([&] { return trajectory.getNumSubscribers() > 0; }, 30.0));
@@ -231,10 +243,10 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
   EXPECT_TRUE(reset.response.success) << reset.response.message;
   const auto open = hand.stepFrames(1);
   EXPECT_FALSE(open.state.in_contact[0] || open.state.in_contact[1]);
-  // The parallel GripperCommand of a two-finger hand closes it; ~base_pose streamed a pose per
-  // frame lifts it, and the cube with it.
+  // The parallel GripperCommand of a two-finger hand closes it; a base pose with each ~step, one
+  // per frame, lifts it, and the cube with it.
   ros::Publisher gripper = hand.nh.advertise<norm2tex::GripperCommand>("/gripper/command", 1);
-  ros::Publisher base = hand.nh.advertise<geometry_msgs::PoseStamped>("/hand_sim/base_pose", 100);
+  ros::Publisher base = hand.nh.advertise<geometry_msgs::PoseStamped>("/hand_sim/base_pose", 1);
   ASSERT_TRUE(waitFor(
       [&] { return gripper.getNumSubscribers() > 0 && base.getNumSubscribers() > 0; }, 30.0));
   norm2tex::GripperCommand command;
@@ -248,28 +260,101 @@ TEST(HandSimRos, EveryFrameGivesExactlyOneImagePerSensorAndTheHandGraspsByTrajec
       },
       30.0));
   hand.stepFrames(60);
-  geometry_msgs::PoseStamped pose;
-  pose.header.frame_id = "world";
-  pose.pose.position.z = 0.133;
-  pose.pose.orientation.x = 1.0;  // the hand upside down: 180 degrees about x
-  unsigned published = 0;
+  const double cube_before =
+      hand.buffer.lookupTransform("world", "object", hand.stepFrames(1).stamp, ros::Duration(10.0))
+          .transform.translation.z;
+  geometry_msgs::Pose pose;
+  pose.orientation.x = 1.0;  // the hand upside down: 180 degrees about x
   for (int k = 1; k <= 30; ++k) {
-    pose.pose.position.z = 0.133 + 0.001 * k;
-    base.publish(pose);
-    ++published;
-    hand.stepFrames(1);
+    pose.position.z = 0.133 + 0.001 * k;
+    const auto moved = hand.stepFrames(1, pose);
+    // Each pose is reached over its own step's frame: the root is there at that frame's stamp.
+    ASSERT_NEAR(hand.base(moved.stamp).translation.z, pose.position.z, 1e-9) << "pose " << k;
   }
   const auto lifted = hand.stepFrames(10);
   EXPECT_TRUE(lifted.state.in_contact[0] && lifted.state.in_contact[1]);
+  EXPECT_NEAR(hand.base(lifted.stamp).translation.z, 0.163, 1e-9);
   const geometry_msgs::TransformStamped cube_in_world =
-      hand.buffer.lookupTransform("world", "object", lifted.stamp, ros::Duration(5.0));
-  EXPECT_GT(cube_in_world.transform.translation.z, 0.015 + 0.02) << published << " poses sent";
+      hand.buffer.lookupTransform("world", "object", lifted.stamp, ros::Duration(10.0));
+  // Held, the cube rises with the hand's 30 mm (it slips in the gels by nanometres).
+  EXPECT_NEAR(cube_in_world.transform.translation.z - cube_before, 0.030, 0.1e-3);
+
+  // ~base_pose streams poses to a hand that runs on: it is not ordered with ~step, so the base
+  // reaches the pose at some step after the message arrives.
+  geometry_msgs::PoseStamped streamed;
+  streamed.header.frame_id = "world";
+  streamed.pose = pose;
+  streamed.pose.position.z = 0.164;
+  base.publish(streamed);
+  ASSERT_TRUE(waitFor(
+      [&] { return hand.base(hand.stepFrames(1).stamp).translation.z > 0.164 - 1e-9; }, 60.0));
 
   norm2tex::HandStep zero;
   zero.request.frames = 0;
   ASSERT_TRUE(hand.step.call(zero));
   EXPECT_FALSE(zero.response.success);
   EXPECT_NE(zero.response.message.find("frames = 0 refused"), std::string::npos);
+}
+
+TEST(HandSimRos, AStepWithABasePoseThatIsNotOneIsRefusedWithTheReasonAndChangesNothing) {
+  Hand hand;
+  norm2tex::HandReset reset;
+  ASSERT_TRUE(hand.reset.call(reset));
+  ASSERT_TRUE(reset.response.success) << reset.response.message;
+  const auto before = hand.stepFrames(1);
+  const geometry_msgs::Transform base_before = hand.base(before.stamp);
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  geometry_msgs::Pose upside_down;  // the yaml's base pose: 180 degrees about x
+  upside_down.position.z = 0.133;
+  upside_down.orientation.x = 1.0;
+  struct Bad {
+    geometry_msgs::Pose pose;
+    std::string reason;
+  };
+  std::vector<Bad> bad(4, Bad{upside_down, ""});
+  bad[0].pose.position.z = nan;
+  bad[0].reason = "base_pose: position (0, 0, nan) is not finite";
+  bad[1].pose.orientation = geometry_msgs::Quaternion();  // all zero: the message's default
+  bad[1].reason = "base_pose: orientation (x 0, y 0, z 0, w 0) is not a unit quaternion (length 0)";
+  bad[2].pose.orientation.w = 1.0;
+  bad[2].reason = "is not a unit quaternion (length 1.41421)";
+  bad[3].pose.orientation.w = nan;
+  bad[3].reason = "base_pose: orientation (x 1, y 0, z 0, w nan) is not a unit quaternion;";
+  for (const Bad& b : bad) {
+    norm2tex::HandStep srv;
+    srv.request.frames = 5;
+    srv.request.set_base_pose = true;
+    srv.request.base_pose = b.pose;
+    // Valid targets in the same request: refused with it.
+    srv.request.targets.name = {"base_joint_gripper_left", "base_joint_gripper_right"};
+    srv.request.targets.position = {-0.016, 0.016};
+    ASSERT_TRUE(hand.step.call(srv)) << b.reason;  // answered: hand_sim is still there
+    EXPECT_FALSE(srv.response.success) << b.reason;
+    EXPECT_NE(srv.response.message.find("~step refused, nothing changed: "), std::string::npos)
+        << srv.response.message;
+    EXPECT_NE(srv.response.message.find(b.reason), std::string::npos) << srv.response.message;
+  }
+
+  // Nothing changed: no frame was stepped, no target set, the root did not move.
+  const auto after = hand.stepFrames(1);
+  EXPECT_EQ(after.frame, before.frame + 1);
+  EXPECT_EQ(after.state.joint_targets, before.state.joint_targets);
+  const geometry_msgs::Transform base_after = hand.base(after.stamp);
+  EXPECT_EQ(base_after.translation.z, base_before.translation.z);
+  EXPECT_EQ(base_after.rotation.x, base_before.rotation.x);
+  EXPECT_EQ(base_after.rotation.w, base_before.rotation.w);
+
+  // A pose is taken by the step that carries it; without the flag, base_pose is ignored.
+  geometry_msgs::Pose up = upside_down;
+  up.position.z = 0.143;
+  EXPECT_NEAR(hand.base(hand.stepFrames(1, up).stamp).translation.z, 0.143, 1e-9);
+  norm2tex::HandStep unflagged;
+  unflagged.request.frames = 1;
+  unflagged.request.base_pose.position.z = nan;
+  ASSERT_TRUE(hand.step.call(unflagged));
+  EXPECT_TRUE(unflagged.response.success) << unflagged.response.message;
+  EXPECT_NEAR(hand.base(unflagged.response.stamp).translation.z, 0.143, 1e-9);
 }
 
 TEST(HandSimTexture, ANormalMapWithoutMaterialTexturesTheGraspAndLabelsTheEpisode) {

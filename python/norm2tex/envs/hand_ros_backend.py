@@ -130,7 +130,9 @@ class HandRosBackend(RosClient):
     def step(self, targets, frames=1):
         """~step: the actuated joints' targets, then `frames` sensor frames; returns once every
         sensor's image of the last frame is here. Raises norm2tex.Error with hand_sim's reason
-        when it refuses (nothing moved) or a frame failed."""
+        when it refuses (nothing moved) or a frame failed. The hand's root stays where the hand
+        yaml puts it, as in-process (the request's ``set_base_pose`` is false; a client moving
+        the root sends ``base_pose`` in its ~step request, ordered with the frames)."""
         request = self._HandStep._request_class()
         request.frames = int(frames)
         request.targets.name = self.actuated_joints
