@@ -16,6 +16,7 @@
 #include "norm2tex/shear/layer_compliance.hpp"
 #include "norm2tex/shear/marker_pattern.hpp"
 #include "norm2tex/shear/shear_field.hpp"
+#include "norm2tex/shear/shear_grid.hpp"
 #include "norm2tex/shear/surface_displacement.hpp"
 #include "test_helpers.hpp"
 
@@ -266,6 +267,37 @@ SensorModel markedModel() {
 }
 
 // Dots measured in a drawn image: their centres at the pitch, their size the diameter.
+TEST(ShearGrid, CellsAverageThePenetrationTheyCoverEvenWhereTheImageCutsThem) {
+  SensorModel model = makeDigitSensorModel();
+  const ShearGrid grid = ShearGrid::of(model);
+  // 0.4 mm at 0.054 mm per pixel: 7 px cells, 35 x 46 of them over 240 x 320 px (the last
+  // column and row of cells 2 and 5 px wide).
+  EXPECT_EQ(grid.cell_px, 7);
+  EXPECT_NEAR(grid.cell_mm, 7 * model.mm_per_pixel, 1e-12);
+  EXPECT_EQ(grid.size, cv::Size(35, 46));
+  EXPECT_EQ(grid.image, model.imageSize());
+  EXPECT_EQ(ShearGrid::of(model, 16).size, cv::Size(15, 20));
+  test::expectError([&] { ShearGrid::of(model, -1); }, {"cell_px"});
+
+  // Rows of value = row index: a cell's mean is the mean of its rows, the cut last row's too.
+  cv::Mat1f h(model.imageSize());
+  for (int r = 0; r < h.rows; ++r) h.row(r).setTo(static_cast<float>(r));
+  cv::Mat1f cells;
+  meanCellPenetration(h, cv::Rect(), grid, cells);
+  ASSERT_EQ(cells.size(), grid.size);
+  EXPECT_FLOAT_EQ(cells(0, 0), 3.0f);        // rows 0..6
+  EXPECT_FLOAT_EQ(cells(45, 34), 317.0f);    // rows 315..319, columns 238..239
+  // Only cells the covered box reaches are read (whole: outside its box H_sensor is 0); the
+  // others are 0.
+  cv::Mat1f boxed;
+  meanCellPenetration(h, cv::Rect(0, 0, 240, 10), grid, boxed);
+  EXPECT_FLOAT_EQ(boxed(0, 0), 3.0f);
+  EXPECT_FLOAT_EQ(boxed(1, 0), 10.0f);       // rows 7..13
+  EXPECT_FLOAT_EQ(boxed(2, 0), 0.0f);
+  test::expectError([&] { meanCellPenetration(cv::Mat1f(10, 10, 0.0f), cv::Rect(), grid, cells); },
+                    {"10 x 10", "240 x 320"});
+}
+
 TEST(MarkerPattern, DotsRenderAtTheConfiguredPitchAndDiameter) {
   const SensorModel m = markedModel();
   const MarkerPattern pattern(m);

@@ -9,6 +9,7 @@
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/shear/contact_traction.hpp"
 #include "norm2tex/shear/marker_pattern.hpp"
+#include "norm2tex/shear/shear_grid.hpp"
 #include "norm2tex/shear/surface_displacement.hpp"
 
 namespace norm2tex {
@@ -52,18 +53,17 @@ class ShearField {
   void drawMarkers(cv::Mat3b& image, const ShearFrame& frame) const;
 
   bool hasMarkers() const { return markers_ != nullptr; }
-  int cellPx() const { return cell_px_; }
+  int cellPx() const { return grid_.cell_px; }
+  const ShearGrid& grid() const { return grid_; }
 
   /// The default cell's side, mm.
-  static constexpr double kShearCellMm = 0.4;
+  static constexpr double kShearCellMm = ShearGrid::kDefaultCellMm;
 
  private:
   void placeMarkers(ShearFrame& out) const;
 
   SensorModel model_;
-  int cell_px_ = 0;
-  double cell_mm_ = 0.0;
-  cv::Size grid_;
+  ShearGrid grid_;
   std::unique_ptr<SurfaceDisplacement> displacement_;
   std::unique_ptr<MarkerPattern> markers_;
   cv::Mat1f penetration_;

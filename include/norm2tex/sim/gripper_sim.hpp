@@ -25,6 +25,15 @@ struct GelContactState {
   double normal_force_n = 0.0;
   /// Tangential force the object applies to the gel, N, in the gel frame (z is ~0).
   Eigen::Vector3d shear_force_n = Eigen::Vector3d::Zero();
+  /// Where the normal force acts: the contact points' centroid weighted by their normal forces,
+  /// gel frame x, y, metres (0 without contact points).
+  Eigen::Vector2d pressure_centre_m = Eigen::Vector2d::Zero();
+  /// Twisting moment the object applies to the gel about its +z through pressure_centre_m, N m
+  /// (positive turns +x towards +y; ShearLoad::torque_nm): the moment of the contact points'
+  /// friction forces (contactResultant). A contact held by one point has none of those: the
+  /// torsional friction Bullet gives a lone point (GelPadContacts) is not reported back by its
+  /// solver, so such a contact reports 0.
+  double twist_moment_nm = 0.0;
   /// Deepest penetration of the object into the undeformed gel surface, metres (>= 0): the
   /// indentation the renderer draws at this pose.
   double penetration_m = 0.0;

@@ -37,10 +37,10 @@ struct TactileGripperOptions {
   /// images then depend only on its seeds, not on what ran before (what a learning environment
   /// needs: reset(seed) twice, the same frames). The ROS system counts from its start.
   bool noise_per_episode = false;
-  /// Render the gel's lateral motion from the physics' tangential force (frame.shear: the
-  /// traction, the slip, the surface's displacement, the markers carried). Always on when the
-  /// sensor has markers; off otherwise by default (it costs 0.15-0.25 ms a frame and changes
-  /// nothing in a marker-less frame).
+  /// Render the gel's lateral motion from the physics' tangential force and twist
+  /// (frame.shear: the traction, the slip, the surface's displacement, the markers carried).
+  /// Always on when the sensor has markers; off otherwise by default (it costs 0.15-0.25 ms a
+  /// frame and changes nothing in a marker-less frame).
   bool shear = false;
   /// The episode the gripper starts with (contact_sim ~seed, ~height_offset: NaN = drawn).
   std::uint64_t seed = 0;

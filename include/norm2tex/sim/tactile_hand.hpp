@@ -34,10 +34,10 @@ struct TactileHandOptions {
   /// Count f from each reset's first frame instead of from construction (an episode's images
   /// then depend only on its seeds and commands).
   bool noise_per_episode = false;
-  /// Render the gel's lateral motion from the physics' tangential force (frame.shear: the
-  /// traction, the slip, the surface's displacement, the markers carried). Always on when the
-  /// sensor has markers; off otherwise by default (it costs 0.15-0.25 ms a frame and changes
-  /// nothing in a marker-less frame).
+  /// Render the gel's lateral motion from the physics' tangential force and twist
+  /// (frame.shear: the traction, the slip, the surface's displacement, the markers carried).
+  /// Always on when the sensor has markers; off otherwise by default (it costs 0.15-0.25 ms a
+  /// frame and changes nothing in a marker-less frame).
   bool shear = false;
   /// Threads the sensors render on, the caller's included (each sensor's frame is the same
   /// whatever the count): 1 renders them one after another (for hands already run in parallel,

@@ -67,8 +67,8 @@ class GripperVectorEnv(spaces.EnvBase):
       force: also "force": normal force of each gel (2,) float32, N.
       markers: also "markers_left"/"markers_right": every marker's displacement on the gel
         (markers, 2) float32, mm (gel frame x, y), carried by the gel's lateral motion under the
-        physics' tangential force; needs a sensor with a marker grid (its yaml's markers:) and
-        the in-process backend.
+        physics' tangential force and twist; needs a sensor with a marker grid (its yaml's
+        markers:) and the in-process backend.
       frames_per_step: sensor frames per step.
       max_episode_steps: truncation (None: never).
       backend: "inprocess" or "ros" (num_envs 1; ros_options are RosBackend's arguments).

@@ -1,12 +1,16 @@
 #include "norm2tex/sim/contact_patch.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 
 namespace norm2tex {
 
 ContactPatchMeter::ContactPatchMeter(const SensorModel& model)
-    : model_(model), rasterizer_(model) {}
+    : model_(model),
+      rasterizer_(model),
+      grid_(ShearGrid::of(
+          model, std::max(1, static_cast<int>(std::lround(kSlipCellMm / model.mm_per_pixel))))) {}
 
 ContactPatch ContactPatchMeter::measure(const TexturedMesh& mesh,
                                         const Eigen::Isometry3d& object_in_gel) {
@@ -37,6 +41,23 @@ ContactPatch ContactPatchMeter::measure(const TexturedMesh& mesh,
     patch.centroid_m = Eigen::Vector2d(centroid_mm.x, centroid_mm.y) * 1e-3;
     patch.max_indentation_m = static_cast<double>(deepest_mm) * 1e-3;
   }
+  return patch;
+}
+
+ContactPatch ContactPatchMeter::measure(const TexturedMesh& mesh,
+                                        const Eigen::Isometry3d& object_in_gel,
+                                        double normal_force_n, const ShearLoad& load) {
+  ContactPatch patch = measure(mesh, object_in_gel);
+  const double friction = load.friction.value_or(model_.shear.friction);
+  // Checked with or without contact: a bad load is the caller's mistake either way.
+  if (patch.pixels == 0) {
+    solveContactTraction(cv::Mat1f(), grid_.cell_mm, normal_force_n, load, friction);
+    return patch;
+  }
+  meanCellPenetration(raster_.h_sensor_mm, raster_.covered_box, grid_, penetration_);
+  patch.slip_fraction =
+      solveContactTraction(penetration_, grid_.cell_mm, normal_force_n, load, friction)
+          .slip_fraction;
   return patch;
 }
 

@@ -225,6 +225,8 @@ void GelPadContacts::measure(double dt, const Eigen::Isometry3d& object_in_world
     }
     state.too_deep = state.penetration_m > deepest_law_point;
     Eigen::Vector3d shear_world = Eigen::Vector3d::Zero();
+    const Eigen::Isometry3d world_in_gel = gel_in_world.inverse();
+    loads_.clear();
     forEachPoint(pad, [&](const btManifoldPoint& point) {
       const double normal = point.getAppliedImpulse() / dt;
       // Friction impulses act on body A (the gel) along the lateral directions.
@@ -234,11 +236,21 @@ void GelPadContacts::measure(double dt, const Eigen::Isometry3d& object_in_world
           dt;
       state.normal_force_n += normal;
       shear_world += friction;
-      if (visit) visit(static_cast<int>(i), toEigen(point.m_positionWorldOnA), normal, friction);
+      const Eigen::Vector3d on_gel = toEigen(point.m_positionWorldOnA);
+      PointLoad load;
+      load.position_m = (world_in_gel * on_gel).head<2>();
+      load.normal_n = normal;
+      load.tangential_n = (world_in_gel.linear() * friction).head<2>();
+      loads_.push_back(load);
+      if (visit) visit(static_cast<int>(i), on_gel, normal, friction);
     });
     state.in_contact = state.penetration_m > 0.0 && state.normal_force_n > 0.0;
     state.shear_force_n = gel_in_world.linear().transpose() * shear_world;
     state.shear_force_n.z() = 0.0;
+    // Where the contact's normal force acts and how hard it twists the gel about it.
+    const ContactResultant resultant = contactResultant(loads_);
+    state.pressure_centre_m = resultant.pressure_centre_m;
+    state.twist_moment_nm = resultant.twist_moment_nm;
   }
 }
 

@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "norm2tex/sim/contact_resultant.hpp"
 #include "norm2tex/sim/gel_contact.hpp"
 #include "norm2tex/gel/gel_law.hpp"
 #include "norm2tex/sim/gripper_sim.hpp"
@@ -131,6 +132,7 @@ class GelPadContacts {
   std::vector<Pad> pads_;
   btRigidBody* object_ = nullptr;
   GelContactGeometry geometry_;
+  std::vector<PointLoad> loads_;  // measure()'s per-point loads of one pad, reused
 };
 
 }  // namespace norm2tex
