@@ -123,5 +123,8 @@ class BagDataset(torch.utils.data.IterableDataset):
         if contact is not None:
             labels.update(in_contact=int(contact.in_contact), normal_force=contact.normal_force,
                           max_indentation=contact.max_indentation,
-                          contact_area=contact.contact_area)
+                          contact_area=contact.contact_area,
+                          # Bags recorded before TactileContact had these read as NaN.
+                          twist_moment=getattr(contact, "twist_moment", float("nan")),
+                          slip_fraction=getattr(contact, "slip_fraction", float("nan")))
         return tensor, labels

@@ -10,7 +10,8 @@ from PIL import Image
 _NUMERIC = {
     "variant": int, "stamp": int, "episode": int, "beta": float, "seed": int, "shard": int,
     "press": int, "press_depth": float, "in_contact": int, "normal_force": float,
-    "max_indentation": float, "contact_area": float,
+    "max_indentation": float, "contact_area": float, "twist_moment": float,
+    "slip_fraction": float,
 }
 
 

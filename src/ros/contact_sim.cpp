@@ -25,6 +25,7 @@
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/contact_shear_load.hpp"
 #include "norm2tex/sim/tactile_gripper_batch.hpp"
 #include "params.hpp"
 
@@ -532,7 +533,9 @@ std::uint32_t ContactSim::publishFrame() {
     std_msgs::Header header;
     header.stamp = stamp;
     header.frame_id = kGelFrames[i];
-    const ContactPatch patch = meters_[i]->measure(sim_->object().mesh, state.object_in_gel);
+    const ContactPatch patch =
+        meters_[i]->measure(sim_->object().mesh, state.object_in_gel, state.normal_force_n,
+                            shearLoadOf(state, sim_->config().object.friction));
     contact_pub_[i].publish(ros_conversions::toContactMsg(header, kSensorNames[i], state, patch));
   }
 
@@ -551,9 +554,9 @@ std::uint32_t ContactSim::publishFrame() {
   frame.next_material = next_material_;
   frame.next_variant = next_variant_;
   for (int i = 0; i < 2; ++i) {
-    frame.sensors.push_back(kSensorNames[i]);
-    frame.normal_force.push_back(sim_->contact(static_cast<Finger>(i)).normal_force_n);
+    ros_conversions::addSensorLoad(frame, kSensorNames[i], sim_->contact(static_cast<Finger>(i)));
   }
+  frame.friction = sim_->config().object.friction;
   // Lock-step: every renderer answers this frame before the next one is simulated.
   const std::uint32_t missing = lock_step_->publish(frame_pub_, frame);
   trace_.mark(kTraceFrame);

@@ -7,6 +7,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/sim/contact_shear_load.hpp"
 
 namespace norm2tex {
 namespace ros_conversions {
@@ -56,6 +57,55 @@ TactileContact toContactMsg(const std_msgs::Header& header, const std::string& s
   msg.centroid.x = patch.centroid_m.x();
   msg.centroid.y = patch.centroid_m.y();
   msg.centroid.z = 0.0;
+  msg.twist_moment = state.twist_moment_nm;
+  msg.slip_fraction = patch.slip_fraction;
+  return msg;
+}
+
+void addSensorLoad(SimFrame& frame, const std::string& sensor, const GelContactState& state) {
+  frame.sensors.push_back(sensor);
+  frame.normal_force.push_back(state.normal_force_n);
+  geometry_msgs::Vector3 shear;
+  tf2::toMsg(state.shear_force_n, shear);
+  frame.shear_force.push_back(shear);
+  frame.twist_moment.push_back(state.twist_moment_nm);
+}
+
+std::optional<ShearLoad> shearLoadIn(const SimFrame& frame, const std::string& sensor) {
+  // Sources of older versions (and probe_sim, which has no tangential load) name no shear: the
+  // arrays are shorter than `sensors`.
+  for (std::size_t i = 0; i < frame.sensors.size(); ++i) {
+    if (frame.sensors[i] != sensor) continue;
+    if (i >= frame.shear_force.size() || i >= frame.twist_moment.size()) return std::nullopt;
+    return shearLoadOf(Eigen::Vector2d(frame.shear_force[i].x, frame.shear_force[i].y),
+                       frame.twist_moment[i], frame.friction);
+  }
+  return std::nullopt;
+}
+
+TactileMarkers toMarkersMsg(const std_msgs::Header& header, int rows, int cols,
+                            const ShearFrame& frame) {
+  if (rows < 0 || cols < 0 || frame.markers.size() != static_cast<std::size_t>(rows) * cols) {
+    throw Error("markers: " + std::to_string(frame.markers.size()) + " markers for a grid of " +
+                std::to_string(rows) + " x " + std::to_string(cols));
+  }
+  TactileMarkers msg;
+  msg.header = header;
+  msg.rows = static_cast<std::uint32_t>(rows);
+  msg.cols = static_cast<std::uint32_t>(cols);
+  msg.rest_px.resize(frame.markers.size());
+  msg.current_px.resize(frame.markers.size());
+  msg.displacement_mm.resize(frame.markers.size());
+  for (std::size_t i = 0; i < frame.markers.size(); ++i) {
+    const Marker& m = frame.markers[i];
+    msg.rest_px[i].x = m.rest_px.x;
+    msg.rest_px[i].y = m.rest_px.y;
+    msg.current_px[i].x = m.current_px.x;
+    msg.current_px[i].y = m.current_px.y;
+    msg.displacement_mm[i].x = m.displacement_mm.x;
+    msg.displacement_mm[i].y = m.displacement_mm.y;
+  }
+  msg.slip_fraction = frame.slipFraction();
   return msg;
 }
 
@@ -71,9 +121,13 @@ sensor_msgs::ImagePtr toImageMsg(const std_msgs::Header& header, const cv::Mat& 
     case CV_32FC1:
       encoding = sensor_msgs::image_encodings::TYPE_32FC1;
       break;
+    case CV_32FC2:
+      encoding = sensor_msgs::image_encodings::TYPE_32FC2;
+      break;
     default:
       throw Error("image type " + std::to_string(image.type()) +
-                  " has no sensor_msgs encoding here; valid: CV_8UC3, CV_8UC1, CV_32FC1");
+                  " has no sensor_msgs encoding here; valid: CV_8UC3, CV_8UC1, CV_32FC1, "
+                  "CV_32FC2");
   }
   // One copy of the pixels (row by row for a view into a larger matrix).
   return cv_bridge::CvImage(header, encoding, image).toImageMsg();
@@ -84,12 +138,13 @@ cv::Mat fromImageMsg(const sensor_msgs::Image& msg) {
   if (msg.encoding == "bgr8" || msg.encoding == "rgb8") type = CV_8UC3;
   if (msg.encoding == "mono8") type = CV_8UC1;
   if (msg.encoding == "32FC1") type = CV_32FC1;
+  if (msg.encoding == "32FC2") type = CV_32FC2;
   if (type < 0) {
     throw Error("image encoding '" + msg.encoding +
-                "' is not supported here; valid: bgr8, rgb8, mono8, 32FC1");
+                "' is not supported here; valid: bgr8, rgb8, mono8, 32FC1, 32FC2");
   }
-  if (msg.is_bigendian && type == CV_32FC1) {
-    throw Error("big-endian 32FC1 images are not supported");
+  if (msg.is_bigendian && CV_MAT_DEPTH(type) == CV_32F) {
+    throw Error("big-endian " + msg.encoding + " images are not supported");
   }
   // Checked here, naming the sizes (cv_bridge refuses such a message with less to go on).
   const std::size_t row_bytes = static_cast<std::size_t>(msg.width) * CV_ELEM_SIZE(type);

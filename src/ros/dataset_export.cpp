@@ -37,6 +37,28 @@ std::string csv(const std::string& text) {
   return quoted + "\"";
 }
 
+/// One row per marker of the grid, row by row.
+void writeMarkers(const fs::path& path, const TactileMarkers& m) {
+  fs::create_directories(path.parent_path());
+  std::ofstream out(path);
+  out << "marker,row,col,rest_x_px,rest_y_px,x_px,y_px,dx_mm,dy_mm\n";
+  const std::size_t count = m.rest_px.size();
+  if (m.current_px.size() != count || m.displacement_mm.size() != count ||
+      count != static_cast<std::size_t>(m.rows) * m.cols) {
+    throw Error("markers of " + std::to_string(m.rows) + " x " + std::to_string(m.cols) +
+                " with " + std::to_string(count) + " rest, " +
+                std::to_string(m.current_px.size()) + " current and " +
+                std::to_string(m.displacement_mm.size()) + " displacements: inconsistent");
+  }
+  out << std::setprecision(9);
+  for (std::size_t i = 0; i < count; ++i) {
+    out << i << "," << i / m.cols << "," << i % m.cols << "," << m.rest_px[i].x << ","
+        << m.rest_px[i].y << "," << m.current_px[i].x << "," << m.current_px[i].y << ","
+        << m.displacement_mm[i].x << "," << m.displacement_mm[i].y << "\n";
+  }
+  if (!out) throw Error("writing '" + path.string() + "' failed (disk full or unwritable?)");
+}
+
 }  // namespace
 
 ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOptions& options,
@@ -64,8 +86,10 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
   }
 
   TactileBagReader reader(bags);
+  // Columns added later go at the end, so readers by position keep working.
   labels << "raw,diff,depth,material,variant,sensor,stamp,episode,object,beta,seed,scenario,"
-            "shard,press,press_depth,in_contact,normal_force,max_indentation,contact_area,bag\n";
+            "shard,press,press_depth,in_contact,normal_force,max_indentation,contact_area,bag,"
+            "twist_moment,slip_fraction,markers\n";
   ExportSummary summary;
   std::set<std::string> names;
   reader.forEachSample([&](const TactileSample& s) {
@@ -112,6 +136,12 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
         writeImage(out / depth, s.depth_m);
       }
     }
+    std::string markers;
+    if (s.has_markers) {
+      markers = "markers/" + file + ".csv";
+      writeMarkers(out / markers, s.markers);
+      ++summary.frames_with_markers;
+    }
     const TactileContact& c = s.contact;
     labels << raw << "," << diff << "," << depth << "," << csv(material) << "," << e.variant << ","
            << s.sensor << "," << s.stamp.toNSec() << "," << e.episode << "," << csv(e.object) << ","
@@ -120,7 +150,8 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
            << (s.has_contact ? c.normal_force : NAN) << ","
            << (s.has_contact ? c.max_indentation : NAN) << ","
            << (s.has_contact ? c.contact_area : NAN) << "," << csv(fs::path(s.bag).filename().string())
-           << "\n";
+           << "," << (s.has_contact ? c.twist_moment : NAN) << ","
+           << (s.has_contact ? c.slip_fraction : NAN) << "," << markers << "\n";
     if (!labels) throw Error("writing labels.csv failed (disk full?)");
     ++summary.frames;
     ++summary.frames_per_material[material];
@@ -128,6 +159,7 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
   });
   labels.close();
   if (!labels) throw Error("writing labels.csv failed (disk full?)");
+  summary.warnings = reader.warnings();
 
   std::ofstream yaml(out / "export.yaml");
   yaml << "# norm2tex_export: frames of dataset_recorder bags for training\n"
@@ -142,8 +174,12 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
        << "  depth: "
        << (options.depth_format == "png16" ? "uint16 PNG, gel indentation in micrometres"
                                             : "float32 TIFF, gel indentation in metres")
-       << "\n"
-       << "bags:\n";
+       << "\n";
+  if (summary.frames_with_markers > 0) {
+    yaml << "  markers: CSV per frame, a row per marker: grid row and column, rest and current "
+            "position (pixels, x = column, y = row), displacement (mm, gel frame)\n";
+  }
+  yaml << "bags:\n";
   for (const std::string& bag : bags) yaml << "  - '" << bag << "'\n";
   if (!yaml) throw Error("writing export.yaml failed (disk full?)");
   return summary;

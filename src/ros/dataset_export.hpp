@@ -20,7 +20,10 @@ struct ExportOptions {
 
 struct ExportSummary {
   std::uint64_t frames = 0;
+  std::uint64_t frames_with_markers = 0;
   std::map<std::string, std::uint64_t> frames_per_material;
+  /// What the bags held that could not be read (TactileBagReader::warnings).
+  std::vector<std::string> warnings;
 };
 
 /// Exports dataset_recorder bags for training, in one pass over the bags (TactileBagReader):
@@ -28,6 +31,9 @@ struct ExportSummary {
 ///   OUT/diff/<material>/<name>.png   image - background + 128 per channel (clamped to 0..255),
 ///                                    the paper's classifier input: 128 where nothing touches
 ///   OUT/depth/<material>/<name>.png  gel indentation, uint16 micrometres (or .tiff, float metres)
+///   OUT/markers/<material>/<name>.csv  the frame's markers (sensors with markers): one row per
+///                                    marker, its grid row and column, rest and current position
+///                                    (pixels) and displacement (mm, gel frame)
 ///   OUT/labels.csv                   one row per frame: paths relative to OUT and every label
 ///   OUT/export.yaml                  counts per material, the sources, the encodings
 /// <name> = <sensor>_s<shard>_<stamp in ns>, unique within a recording and across its shards.

@@ -5,11 +5,13 @@
 #include <fstream>
 #include <limits>
 
+#include <ros/master.h>
 #include <rosbag/exceptions.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
 #include "norm2tex/TactileContact.h"
+#include "norm2tex/TactileMarkers.h"
 
 #include "lock_step.hpp"
 #include "norm2tex/common/error.hpp"
@@ -62,6 +64,7 @@ DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& pnh) {
   if (!(p.min_free_mb >= 0.0)) {
     badParameter("min_free_mb", text(p.min_free_mb), ">= 0 MB (0: write until a write fails)");
   }
+  readParam(pnh, "record_shear", p.record_shear, p.record_shear);
   return p;
 }
 
@@ -76,11 +79,12 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
   std::vector<std::string> topics = params_.topics;
   // The per-frame topics typed: in a nodelet manager they arrive without a copy, and their
   // stamps are read without deserialising them again.
-  auto subscribePart = [&](const std::string& topic, auto tag) {
+  auto subscribePart = [&](const std::string& topic, auto tag,
+                           std::vector<ros::Subscriber>& subs) {
     using Message = typename decltype(tag)::type;
     const std::string resolved = nh_.resolveName(topic);
     topics.push_back(topic);
-    part_subs_.push_back(nh_.subscribe<Message>(
+    subs.push_back(nh_.subscribe<Message>(
         topic, 1000, [this, resolved](const ros::MessageEvent<Message const>& e) {
           onFramePart(resolved, e.getConstMessage()->header.stamp,
                       [&](const ros::Time& when) {
@@ -89,10 +93,14 @@ DatasetRecorder::DatasetRecorder(ros::NodeHandle nh, ros::NodeHandle private_nh)
         }));
   };
   for (const std::string& sensor : params_.sensors) {
-    subscribePart(sensor + "/image_raw", MessageTag<sensor_msgs::Image>());
-    subscribePart(sensor + "/camera_info", MessageTag<sensor_msgs::CameraInfo>());
-    subscribePart(sensor + "/depth", MessageTag<sensor_msgs::Image>());
-    subscribePart(sensor + "/contact", MessageTag<TactileContact>());
+    subscribePart(sensor + "/image_raw", MessageTag<sensor_msgs::Image>(), part_subs_);
+    subscribePart(sensor + "/camera_info", MessageTag<sensor_msgs::CameraInfo>(), part_subs_);
+    subscribePart(sensor + "/depth", MessageTag<sensor_msgs::Image>(), part_subs_);
+    subscribePart(sensor + "/contact", MessageTag<TactileContact>(), part_subs_);
+    if (params_.record_shear) {
+      subscribePart(sensor + "/shear", MessageTag<sensor_msgs::Image>(), part_subs_);
+    }
+    subscribePart(sensor + "/markers", MessageTag<TactileMarkers>(), marker_subs_);
   }
   frame_sub_ = nh_.subscribe(params_.frame_topic, 100, &DatasetRecorder::onFrame, this);
   started_ = last_progress_ = ros::WallTime::now();
@@ -142,6 +150,9 @@ void DatasetRecorder::announceReady() {
     if (sub.getNumPublishers() == 0) unconnected += " " + sub.getTopic();
   }
   if (frame_sub_.getNumPublishers() == 0) unconnected += " " + frame_sub_.getTopic();
+  // Markers only of the sensors that have them: their renderers advertise the topic before
+  // their image, so once the images are connected the master knows.
+  if (unconnected.empty()) unconnected = unconnectedMarkers();
   const ros::WallTime now = ros::WallTime::now();
   if (!unconnected.empty()) {
     ROS_INFO_THROTTLE(5.0, "dataset_recorder: waiting for publishers of%s", unconnected.c_str());
@@ -163,6 +174,27 @@ void DatasetRecorder::announceReady() {
   ready.sensor = params_.answer_as;
   ready.reason = lock_step::kReady;
   answer_pub_.publish(ready);
+}
+
+std::string DatasetRecorder::unconnectedMarkers() const {
+  std::string unconnected;
+  std::vector<ros::master::TopicInfo> advertised;
+  bool asked = false;
+  for (const ros::Subscriber& sub : marker_subs_) {
+    if (sub.getNumPublishers() > 0) continue;
+    if (!asked && !ros::master::getTopics(advertised)) return " (the master's topics)";
+    asked = true;
+    for (const ros::master::TopicInfo& topic : advertised) {
+      if (topic.name == sub.getTopic()) unconnected += " " + sub.getTopic();
+    }
+  }
+  return unconnected;
+}
+
+int DatasetRecorder::partsPerFrame() const {
+  int parts = static_cast<int>(part_subs_.size());
+  for (const ros::Subscriber& sub : marker_subs_) parts += sub.getNumPublishers() > 0;
+  return parts;
 }
 
 void DatasetRecorder::openNextBag() {
@@ -241,7 +273,9 @@ void DatasetRecorder::onMessage(const std::string& topic,
 void DatasetRecorder::onFramePart(const std::string& topic, const ros::Time& stamp,
                                   const std::function<void(const ros::Time&)>& write_message) {
   if (!write(topic, write_message)) return;
-  if (++parts_at_[stamp] >= 4 * static_cast<int>(params_.sensors.size())) {
+  // A part of a frame already complete (a markers topic that connected while its frame was
+  // under way) is written but counts for nothing: it must not open the frame again.
+  if (!completed_.count(stamp) && ++parts_at_[stamp] >= partsPerFrame()) {
     parts_at_.erase(stamp);
     completed_.insert(stamp);
     // Remembered for a while: the frame's SimFrame may arrive after its last part.
@@ -293,7 +327,7 @@ bool DatasetRecorder::frameComplete(const ros::Time& stamp) const {
 
 void DatasetRecorder::answerFramesWritten() {
   // A synchronous frame is answered once every sensor's image, camera_info, depth and contact of
-  // it are in the bag.
+  // it (and shear, markers) are in the bag.
   for (auto it = waiting_.begin(); it != waiting_.end();) {
     if (!frameComplete(it->first)) {
       ++it;

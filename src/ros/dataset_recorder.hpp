@@ -49,13 +49,17 @@ struct DatasetRecorderParams {
   std::string answer_as = "recorder";
   std::string frame_topic = "contact_sim/frame";      ///< ~frame_topic: the SimFrame source
   std::string answer_topic = "contact_sim/rendered";  ///< ~answer_topic: where answers go
+  /// ~record_shear: also record each sensor's shear (the gel's lateral displacement, 32FC2),
+  /// which makes the renderers compute it for every frame.
+  bool record_shear = false;
 };
 
 DatasetRecorderParams readDatasetRecorderParams(const ros::NodeHandle& private_nh);
 
-/// Writes every message of the sensors' image_raw, camera_info, depth and contact topics and the
-/// extra topics into rosbags, counting what it received and wrote per topic and the images per
-/// episode label. In synchronous mode it answers each SimFrame (as sensor "recorder" on
+/// Writes every message of the sensors' image_raw, camera_info, depth and contact topics (and
+/// markers for sensors that have them, shear with ~record_shear) and the extra topics into
+/// rosbags, counting what it received and wrote per topic and the images per episode label.
+/// In synchronous mode it answers each SimFrame (as sensor "recorder" on
 /// contact_sim/rendered) once every sensor's image of that frame is written, so contact_sim can
 /// wait for it: received = written. Closes (indexes) the bag and writes <prefix>_shard<k>.yaml,
 /// the manifest, on close(): at the sample target, on SIGINT/SIGTERM, or on a write error.
@@ -94,13 +98,18 @@ class DatasetRecorder {
   /// "material/variant" of the episode an image stamped `stamp` belongs to.
   std::string labelAt(const ros::Time& stamp) const;
   bool frameComplete(const ros::Time& stamp) const;
+  /// How many per-frame messages make a frame: every sensor's required topics, and the markers
+  /// of the sensors whose renderer publishes them.
+  int partsPerFrame() const;
+  /// The markers topics that are advertised (asked of the master) but not yet connected.
+  std::string unconnectedMarkers() const;
 
   DatasetRecorderParams params_;
   std::unique_ptr<rosbag::Bag> bag_;
   std::vector<std::string> bag_paths_;
   std::map<std::string, std::uint64_t> received_, written_;
-  /// Per frame stamp: messages written of the sensors' image_raw, camera_info, depth, contact;
-  /// a frame is complete at 4 per sensor, and then moves to completed_.
+  /// Per frame stamp: messages written of the sensors' image_raw, camera_info, depth, contact
+  /// (and shear, markers); a frame is complete at partsPerFrame(), and then moves to completed_.
   std::map<ros::Time, int> parts_at_;
   std::set<ros::Time> completed_;  ///< the latest 10000 complete frames
   ros::Time last_image_stamp_;
@@ -125,6 +134,9 @@ class DatasetRecorder {
   ros::NodeHandle nh_;
   std::vector<ros::Subscriber> extra_subs_;  ///< ~topics
   std::vector<ros::Subscriber> part_subs_;   ///< the sensors' per-frame topics
+  /// The sensors' markers: per frame too, but only for sensors whose model has markers (their
+  /// renderer advertises the topic).
+  std::vector<ros::Subscriber> marker_subs_;
   bool extras_subscribed_ = false;
   ros::Subscriber frame_sub_, episode_sub_;
   ros::Publisher answer_pub_;

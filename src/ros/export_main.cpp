@@ -22,7 +22,8 @@ norm2tex::cli::Program makeProgram() {
       "                       [--background SENSOR=FILE.png ...]",
       "Exports dataset_recorder bags for training: DIR/raw/<material>/*.png,\n"
       "DIR/diff/<material>/*.png (image - background + 128), DIR/depth/<material>/*.png\n"
-      "(uint16 micrometres; --depth tiff: float32 metres), DIR/labels.csv and DIR/export.yaml.\n"
+      "(uint16 micrometres; --depth tiff: float32 metres), DIR/markers/<material>/*.csv (sensors\n"
+      "with markers), DIR/labels.csv and DIR/export.yaml.\n"
       "The bags of one recording (split parts, shards) are read in the order given.");
   program.positional("BAG", -1, po::value<std::vector<std::string>>());
   program.add()  //
@@ -77,6 +78,9 @@ int run(const norm2tex::cli::Program& program, int argc, char** argv) {
                      static_cast<unsigned long>(done), done / std::max(now, 1e-9));
       });
   if (last_report >= 0.0 && terminal) std::fprintf(stderr, "\n");
+  for (const std::string& warning : summary.warnings) {
+    std::fprintf(stderr, "norm2tex_export: warning: %s\n", warning.c_str());
+  }
   const double total = seconds();
   std::printf("norm2tex_export: %lu frames in %.2f s (%.0f frames/s) -> %s\n",
               static_cast<unsigned long>(summary.frames), total,

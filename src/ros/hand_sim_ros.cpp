@@ -20,6 +20,7 @@
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/materials/material_config.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/sim/contact_shear_load.hpp"
 #include "params.hpp"
 
 namespace norm2tex {
@@ -251,7 +252,9 @@ std::uint32_t HandSimRos::publishFrame() {
     header.stamp = stamp;
     header.frame_id = sim_->sensor(s).name + "_gel";
     const GelContactState& state = sim_->contact(s);
-    const ContactPatch patch = meters_[s]->measure(sim_->object().mesh, state.object_in_gel);
+    const ContactPatch patch =
+        meters_[s]->measure(sim_->object().mesh, state.object_in_gel, state.normal_force_n,
+                            shearLoadOf(state, sim_->config().object.friction));
     contact_pubs_[s].publish(
         ros_conversions::toContactMsg(header, sim_->sensor(s).name, state, patch));
   }
@@ -263,9 +266,9 @@ std::uint32_t HandSimRos::publishFrame() {
   frame.acknowledge = acknowledge;
   frame.material = params_.material;
   for (int s = 0; s < sim_->sensorCount(); ++s) {
-    frame.sensors.push_back(sim_->sensor(s).name);
-    frame.normal_force.push_back(sim_->contact(s).normal_force_n);
+    ros_conversions::addSensorLoad(frame, sim_->sensor(s).name, sim_->contact(s));
   }
+  frame.friction = sim_->config().object.friction;
   return lock_step_->publish(frame_pub_, frame);
 }
 

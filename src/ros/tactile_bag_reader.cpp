@@ -25,8 +25,28 @@ std::pair<std::string, std::string> splitTopic(const std::string& topic) {
 
 struct Partial {
   TactileSample sample;
-  bool has_image = false, has_depth = false;
+  bool has_image = false, has_depth = false, has_shear = false;
 };
+
+/// The per-frame topics a sample joins.
+bool isFramePart(const std::string& leaf) {
+  return leaf == "image_raw" || leaf == "depth" || leaf == "contact" || leaf == "markers" ||
+         leaf == "shear";
+}
+
+/// The message type this reader reads a per-frame topic as: its MD5 sum, and its name.
+std::pair<std::string, std::string> typeOf(const std::string& leaf) {
+  if (leaf == "contact") {
+    return {ros::message_traits::MD5Sum<TactileContact>::value(),
+            ros::message_traits::DataType<TactileContact>::value()};
+  }
+  if (leaf == "markers") {
+    return {ros::message_traits::MD5Sum<TactileMarkers>::value(),
+            ros::message_traits::DataType<TactileMarkers>::value()};
+  }
+  return {ros::message_traits::MD5Sum<sensor_msgs::Image>::value(),
+          ros::message_traits::DataType<sensor_msgs::Image>::value()};
+}
 
 }  // namespace
 
@@ -56,8 +76,19 @@ std::uint64_t TactileBagReader::forEachSample(
       rosbag::View view(bag);
       for (const rosbag::ConnectionInfo* c : view.getConnections()) {
         const auto [sensor, leaf] = splitTopic(c->topic);
-        if (leaf == "image_raw" || leaf == "depth" || leaf == "contact") leaves[sensor].insert(leaf);
         if (leaf == "background") background_topics.push_back(c->topic);
+        if (!isFramePart(leaf)) continue;
+        // Another version of the message (a bag recorded before a field was added) cannot be
+        // decoded as this one: its frames come without it rather than never.
+        const auto [md5, type] = typeOf(leaf);
+        if (c->md5sum != md5) {
+          warnings_.push_back("'" + path + "': " + c->topic +
+                              " was recorded as another version of " + type + " (MD5 " +
+                              c->md5sum + ", this reader's " + md5 +
+                              "); its frames are read without it");
+          continue;
+        }
+        leaves[sensor].insert(leaf);
       }
     }
     if (background_topics.empty()) continue;
@@ -88,7 +119,9 @@ std::uint64_t TactileBagReader::forEachSample(
   auto complete = [&](const Partial& p) {
     const std::set<std::string>& has = leaves[p.sample.sensor];
     return p.has_image && (p.has_depth || !has.count("depth")) &&
-           (p.sample.has_contact || !has.count("contact"));
+           (p.sample.has_contact || !has.count("contact")) &&
+           (p.sample.has_markers || !has.count("markers")) &&
+           (p.has_shear || !has.count("shear"));
   };
   // Complete frames are handed over in stamp order: a pipelined source's frames may complete
   // out of order by a few; hold them until the bag's time has passed their stamp.
@@ -110,14 +143,19 @@ std::uint64_t TactileBagReader::forEachSample(
       emitReady(&bag_time);
       const auto [sensor, leaf] = splitTopic(m.getTopic());
       if (leaf == "episode" || leaf == "background") continue;  // read above
-      if (leaf != "image_raw" && leaf != "depth" && leaf != "contact") continue;
+      if (!isFramePart(leaf)) continue;
       ros::Time stamp;
       TactileContact::ConstPtr contact;
+      TactileMarkers::ConstPtr markers;
       sensor_msgs::Image::ConstPtr image;
       if (leaf == "contact") {
         contact = m.instantiate<TactileContact>();
         if (!contact) continue;
         stamp = contact->header.stamp;
+      } else if (leaf == "markers") {
+        markers = m.instantiate<TactileMarkers>();
+        if (!markers) continue;
+        stamp = markers->header.stamp;
       } else {
         image = m.instantiate<sensor_msgs::Image>();
         if (!image) continue;
@@ -136,6 +174,14 @@ std::uint64_t TactileBagReader::forEachSample(
         } else if (leaf == "depth") {
           p.sample.depth_m = ros_conversions::fromImageMsg(*image);
           p.has_depth = true;
+        } else if (leaf == "shear") {
+          const cv::Mat shear = ros_conversions::fromImageMsg(*image);
+          if (shear.type() != CV_32FC2) throw Error("shear is not a 32FC2 image");
+          p.sample.shear_m = shear;
+          p.has_shear = true;
+        } else if (leaf == "markers") {
+          p.sample.markers = *markers;
+          p.sample.has_markers = true;
         } else {
           p.sample.contact = *contact;
           p.sample.has_contact = true;

@@ -11,11 +11,13 @@
 #include <sstream>
 #include <thread>
 
+#include <boost/make_shared.hpp>
 #include <ros/package.h>
 #include <opencv2/core/utility.hpp>
 
 #include "conversions.hpp"
 #include "lock_step.hpp"
+#include "norm2tex/TactileMarkers.h"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/memory_reuse.hpp"
 #include "norm2tex/mesh/object_mesh.hpp"
@@ -159,6 +161,12 @@ TactileRendererRos::TactileRendererRos(ros::NodeHandle nh, ros::NodeHandle priva
 
   const std::string& ns = params_.sensor_name;
   const std::uint32_t queue = static_cast<std::uint32_t>(params_.queue_size);
+  // The markers before the image: a recorder that finds the image advertised can then ask the
+  // master whether this sensor has markers to wait for.
+  if (renderer_->model().markers.enabled) {
+    markers_pub_ = nh_.advertise<TactileMarkers>(ns + "/markers", queue);
+  }
+  shear_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/shear", queue);
   image_pub_ = it_.advertise(ns + "/image_raw", queue);
   info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>(ns + "/camera_info", queue);
   depth_pub_ = nh_.advertise<sensor_msgs::Image>(ns + "/depth", queue);
@@ -276,7 +284,9 @@ void TactileRendererRos::followFrameTexture(const SimFrame& frame) {
 
 bool TactileRendererRos::anyoneListens() const {
   return image_pub_.getNumSubscribers() > 0 || info_pub_.getNumSubscribers() > 0 ||
-         depth_pub_.getNumSubscribers() > 0 || (mask_pub_ && mask_pub_.getNumSubscribers() > 0);
+         depth_pub_.getNumSubscribers() > 0 || (mask_pub_ && mask_pub_.getNumSubscribers() > 0) ||
+         (markers_pub_ && markers_pub_.getNumSubscribers() > 0) ||
+         shear_pub_.getNumSubscribers() > 0;
 }
 
 void TactileRendererRos::placeFrameThread() {
@@ -339,12 +349,22 @@ void TactileRendererRos::renderAndPublish(const SimFrame& frame) {
                                       : static_cast<std::int64_t>(params_.noise_seed) * 1000003 +
                                             static_cast<std::int64_t>(frame.frame);
   const std::optional<double> normal_force_n = normalForceIn(frame);
-  const TactileFrame& rendered = renderer_->render(object_in_gel, noise_seed, normal_force_n);
+  // The tangential load moves the gel's surface sideways: what the markers show and /shear
+  // publishes. Without either (a DIGIT's gel has no markers) the image is the same without it,
+  // so the shear stage is skipped.
+  const bool shear_wanted = shear_pub_.getNumSubscribers() > 0;
+  std::optional<ShearLoad> shear;
+  if (markers_pub_ || shear_wanted) {
+    shear = ros_conversions::shearLoadIn(frame, params_.sensor_name);
+  }
+  const TactileFrame& rendered =
+      renderer_->render(object_in_gel, noise_seed, normal_force_n, shear);
   trace_.mark(kTraceRendered);
   if (params_.rehearse_ms > 0.0 && !frame.acknowledge) {
     last_frame_.object_in_gel = object_in_gel;
     last_frame_.noise_seed = noise_seed;
     last_frame_.normal_force_n = normal_force_n;
+    last_frame_.shear = shear;
   }
   std_msgs::Header header;
   header.stamp = frame.header.stamp;
@@ -361,6 +381,20 @@ void TactileRendererRos::renderAndPublish(const SimFrame& frame) {
   }
   if (mask_pub_ && mask_pub_.getNumSubscribers() > 0) {
     mask_pub_.publish(ros_conversions::toImageMsg(header, rendered.contact_mask));
+  }
+  // Every frame when the sensor has markers (a recorder counts on one per image).
+  if (markers_pub_ && rendered.shear) {
+    const MarkerOptions& grid = renderer_->model().markers;
+    markers_pub_.publish(boost::make_shared<TactileMarkers>(
+        ros_conversions::toMarkersMsg(header, grid.rows, grid.cols, *rendered.shear)));
+  }
+  if (shear_wanted) {
+    // The field at every pixel (a full-resolution upsample of the cells): only for listeners.
+    // No load, no markers: the surface has not moved.
+    const cv::Size size = renderer_->model().imageSize();
+    shear_pub_.publish(ros_conversions::toImageMsg(
+        header, rendered.shear ? cv::Mat(rendered.shear->displacementMetres(size))
+                               : cv::Mat(cv::Mat2f::zeros(size))));
   }
 }
 
@@ -439,7 +473,7 @@ void TactileRendererRos::rehearse(const ros::WallTimerEvent&) {
   if (rehearsal_of_ != last_frame_.count) return;
   try {
     renderer_->render(last_frame_.object_in_gel, last_frame_.noise_seed,
-                      last_frame_.normal_force_n);
+                      last_frame_.normal_force_n, last_frame_.shear);
     if (rehearsals_++ == 0) {
       ROS_INFO("%s: rehearsing each real-time frame %.1f ms before the next one is due",
                params_.sensor_name.c_str(), params_.rehearse_ms);

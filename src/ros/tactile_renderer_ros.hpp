@@ -75,8 +75,10 @@ TactileRendererParams readTactileRendererParams(const ros::NodeHandle& private_n
 
 /// The tactile_renderer's work, shared by node and nodelet: for every SimFrame it looks up the
 /// object pose in the gel frame at exactly the frame's stamp, renders H_sensor + beta H_local
-/// through TactileRenderer, and publishes image_raw (bgr8), camera_info, depth (32FC1, m) and
-/// optionally contact_mask, all with the frame's stamp and the gel frame, then answers with a
+/// through TactileRenderer (with the frame's tangential load, when the sensor has markers or
+/// someone listens to shear), and publishes image_raw (bgr8), camera_info, depth (32FC1, m),
+/// optionally contact_mask, markers (when the sensor model has them) and shear (32FC2, m, to
+/// listeners), all with the frame's stamp and the gel frame, then answers with a
 /// FrameRendered. A pose that does not arrive within ~tf_timeout is counted and warned about;
 /// no image is faked for it.
 class TactileRendererRos {
@@ -136,6 +138,8 @@ class TactileRendererRos {
   image_transport::ImageTransport it_;
   image_transport::Publisher image_pub_;
   ros::Publisher info_pub_, depth_pub_, mask_pub_, rendered_pub_, background_pub_;
+  /// <sensor>/markers, advertised only when the sensor model has markers; <sensor>/shear.
+  ros::Publisher markers_pub_, shear_pub_;
   /// The frames' queue, served by frame_spinner_; declared before the subscription on it.
   ros::CallbackQueue frame_queue_;
   ros::Subscriber frame_sub_;
@@ -148,6 +152,7 @@ class TactileRendererRos {
     Eigen::Isometry3d object_in_gel = Eigen::Isometry3d::Identity();
     std::int64_t noise_seed = -1;
     std::optional<double> normal_force_n;
+    std::optional<ShearLoad> shear;
   } last_frame_;
   std::uint64_t rehearsal_of_ = 0;  ///< last_frame_.count the armed rehearsal is for
   std::uint64_t rehearsals_ = 0;

@@ -103,6 +103,10 @@ class DatasetTest(unittest.TestCase):
         self.assertEqual(labels["scenario"], "probe")
         self.assertEqual(labels["in_contact"], 1)
         self.assertIn(labels["material"], ("wood", "fabric"))
+        # The probe presses straight in: nothing slips or twists; a DIGIT has no markers.
+        self.assertEqual(labels["slip_fraction"], 0.0)
+        self.assertEqual(labels["twist_moment"], 0.0)
+        self.assertEqual(labels["markers"], "")
         depth, _ = ExportedDataset(self.export, image="depth")[0]
         self.assertEqual(tuple(depth.shape), (1, 320, 240))
         self.assertAlmostEqual(depth.max().item(), labels["press_depth"] * 1000.0, delta=0.01)

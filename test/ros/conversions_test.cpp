@@ -95,6 +95,76 @@ TEST(ConversionsTest, ContactMessageCarriesEveryField) {
   EXPECT_DOUBLE_EQ(msg.contact_area, 4.9e-4);
   EXPECT_DOUBLE_EQ(msg.centroid.x, -0.001);
   EXPECT_DOUBLE_EQ(msg.centroid.y, 0.002);
+  EXPECT_EQ(msg.twist_moment, 0.0);
+  EXPECT_EQ(msg.slip_fraction, 0.0);
+  state.twist_moment_nm = -3.5e-3;
+  patch.slip_fraction = 0.25;
+  const TactileContact twisted = ros_conversions::toContactMsg(header, "digit_left", state, patch);
+  EXPECT_DOUBLE_EQ(twisted.twist_moment, -3.5e-3);
+  EXPECT_DOUBLE_EQ(twisted.slip_fraction, 0.25);
+}
+
+TEST(ConversionsTest, AFrameCarriesEachGelsLoadToItsRenderer) {
+  GelContactState left, right;
+  left.normal_force_n = 5.0;
+  left.shear_force_n = Eigen::Vector3d(0.1, 0.2, 0.0);
+  left.twist_moment_nm = 1e-3;
+  right.normal_force_n = 6.0;
+  right.shear_force_n = Eigen::Vector3d(-0.3, 0.4, 0.0);
+  right.twist_moment_nm = -2e-3;
+  SimFrame frame;
+  ros_conversions::addSensorLoad(frame, "digit_left", left);
+  ros_conversions::addSensorLoad(frame, "digit_right", right);
+  frame.friction = 0.45;
+  ASSERT_EQ(frame.sensors.size(), 2u);
+  EXPECT_EQ(frame.normal_force[1], 6.0);
+  const std::optional<ShearLoad> load = ros_conversions::shearLoadIn(frame, "digit_right");
+  ASSERT_TRUE(load.has_value());
+  EXPECT_EQ(load->force_n, Eigen::Vector2d(-0.3, 0.4));
+  EXPECT_EQ(load->torque_nm, -2e-3);
+  ASSERT_TRUE(load->friction.has_value());
+  EXPECT_EQ(*load->friction, 0.45);
+  EXPECT_EQ(ros_conversions::shearLoadIn(frame, "digit_left")->force_n, Eigen::Vector2d(0.1, 0.2));
+  // A sensor the frame does not name, or a frame without shear (an older source, probe_sim's
+  // press), gives none; no friction: the sensor model's.
+  EXPECT_FALSE(ros_conversions::shearLoadIn(frame, "digit_middle").has_value());
+  frame.friction = 0.0;
+  EXPECT_FALSE(ros_conversions::shearLoadIn(frame, "digit_left")->friction.has_value());
+  frame.shear_force.clear();
+  EXPECT_FALSE(ros_conversions::shearLoadIn(frame, "digit_left").has_value());
+}
+
+TEST(ConversionsTest, MarkersMessageKeepsTheGridAndItsMotion) {
+  ShearFrame frame;
+  frame.traction.contact_cells = 4;
+  frame.traction.stick_cells = 3;
+  frame.traction.slip_fraction = 0.25;
+  for (int i = 0; i < 6; ++i) {
+    Marker m;
+    m.rest_px = {10.0f * i, 20.0f};
+    m.displacement_mm = {0.01f * i, -0.02f};
+    m.current_px = {10.0f * i + 0.5f, 19.5f};
+    frame.markers.push_back(m);
+  }
+  std_msgs::Header header;
+  header.frame_id = "digit_left_gel";
+  header.stamp = ros::Time(2, 3);
+  const TactileMarkers msg = ros_conversions::toMarkersMsg(header, 2, 3, frame);
+  EXPECT_EQ(msg.header.stamp, ros::Time(2, 3));
+  EXPECT_EQ(msg.header.frame_id, "digit_left_gel");
+  EXPECT_EQ(msg.rows, 2u);
+  EXPECT_EQ(msg.cols, 3u);
+  ASSERT_EQ(msg.rest_px.size(), 6u);
+  ASSERT_EQ(msg.current_px.size(), 6u);
+  ASSERT_EQ(msg.displacement_mm.size(), 6u);
+  EXPECT_EQ(msg.rest_px[4].x, 40.0f);
+  EXPECT_EQ(msg.current_px[4].y, 19.5f);
+  EXPECT_EQ(msg.displacement_mm[5].x, frame.markers[5].displacement_mm.x);
+  EXPECT_EQ(msg.displacement_mm[5].y, -0.02f);
+  EXPECT_EQ(msg.rest_px[0].z, 0.0f);
+  EXPECT_DOUBLE_EQ(msg.slip_fraction, 0.25);
+  test::expectError([&] { ros_conversions::toMarkersMsg(header, 3, 3, frame); },
+                    {"6 markers", "3 x 3"});
 }
 
 TEST(ConversionsTest, ImagesKeepTheirPixelsAndEncodings) {
@@ -134,6 +204,15 @@ TEST(ConversionsTest, ImageMessagesComeBackAsTheSamePixels) {
   const cv::Mat depth_back =
       ros_conversions::fromImageMsg(*ros_conversions::toImageMsg(header, depth));
   EXPECT_EQ(cv::norm(depth_back, depth, cv::NORM_INF), 0.0);
+  // The shear field: two channels, x and y, metres.
+  cv::Mat2f shear(4, 3, cv::Vec2f(1e-4f, -2e-5f));
+  shear(1, 2) = cv::Vec2f(-3e-4f, 5e-4f);
+  const sensor_msgs::ImagePtr shear_msg = ros_conversions::toImageMsg(header, shear);
+  EXPECT_EQ(shear_msg->encoding, "32FC2");
+  EXPECT_EQ(shear_msg->step, 3u * 8u);
+  const cv::Mat shear_back = ros_conversions::fromImageMsg(*shear_msg);
+  ASSERT_EQ(shear_back.type(), CV_32FC2);
+  EXPECT_EQ(cv::norm(shear_back, shear, cv::NORM_INF), 0.0);
   // rgb8 (other drivers) arrives as BGR; padded rows (step > width) are unpadded.
   sensor_msgs::Image rgb;
   rgb.encoding = "rgb8";
