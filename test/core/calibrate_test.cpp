@@ -75,7 +75,7 @@ cv::Mat3f difference(const cv::Mat3b& frame, const cv::Mat3b& background) {
 // shadow and skirt); refinement against the model then recovers the true circle.
 TEST(PressDetection, FindsARenderedPressAndRefinementRecoversItsCircle) {
   const SensorModel m = makeDigitSensorModel();
-  const cv::Mat3b background = makeSyntheticBackground(m.imageSize());
+  const cv::Mat3b background = makeSyntheticBackground(m);
   const DigitShader shader(m, background, BackgroundSource::kSynthetic);
   for (const PressCircle& truth : spreadPresses(m, 6)) {
     PressObservation press;
@@ -101,7 +101,7 @@ TEST(PressScale, TwoPressesAKnownDistanceApartGiveTheScale) {
   for (const double truth_scale : {0.0532, 0.060}) {
     SensorModel m = makeDigitSensorModel();
     m.mm_per_pixel = truth_scale;
-    const cv::Mat3b background = makeSyntheticBackground(m.imageSize());
+    const cv::Mat3b background = makeSyntheticBackground(m);
     const DigitShader shader(m, background, BackgroundSource::kSynthetic);
     const auto pressAt = [&](double x_mm, double y_mm) {
       const PressCircle circle{{x_mm / m.mm_per_pixel + 0.5 * m.cols - 0.5,
@@ -119,7 +119,7 @@ TEST(PressScale, TwoPressesAKnownDistanceApartGiveTheScale) {
     }
   }
   const SensorModel m = makeDigitSensorModel();
-  const cv::Mat3b background = makeSyntheticBackground(m.imageSize());
+  const cv::Mat3b background = makeSyntheticBackground(m);
   const DigitShader shader(m, background, BackgroundSource::kSynthetic);
   const cv::Mat3b press = renderPress(m, shader, spreadPresses(m, 1)[0], 5);
   test::expectError(
@@ -142,7 +142,7 @@ TEST(PressScale, TwoPressesAKnownDistanceApartGiveTheScale) {
 
 TEST(PressDetection, NoPressIsAClearError) {
   const SensorModel m = makeDigitSensorModel();
-  const DigitShader shader(m, makeSyntheticBackground(m.imageSize()), BackgroundSource::kSynthetic);
+  const DigitShader shader(m, makeSyntheticBackground(m), BackgroundSource::kSynthetic);
   const cv::Mat1f flat(m.rows, m.cols, 0.0f);
   const cv::Mat3f noise_only = difference(shader.shade(flat, 1), shader.shade(flat, 2));
   test::expectError([&] { detectPress(noise_only, "empty.png"); }, {"empty.png", "no press"});
@@ -164,7 +164,7 @@ TEST(BallPress, IndentationIsTheSphericalCapOfTheContact) {
 // Noise drawn with known options over a smooth background is measured back.
 TEST(BackgroundNoise, MeasuresTheNoiseItWasGiven) {
   const SensorModel m = makeDigitSensorModel();
-  const cv::Mat3b smooth = makeSyntheticBackground(m.imageSize());
+  const cv::Mat3b smooth = makeSyntheticBackground(m);
   const DigitShader shader(m, smooth, BackgroundSource::kSynthetic);
   const cv::Mat1f flat(m.rows, m.cols, 0.0f);
   std::vector<cv::Mat3b> frames;
@@ -184,7 +184,7 @@ TEST(BackgroundNoise, MeasuresTheNoiseItWasGiven) {
 // fitted model reproduces the held-out presses and recovers the scale.
 TEST(Calibration, RoundTripRecoversTheScaleAndReproducesHeldOutPresses) {
   const SensorModel truth = makeDigitSensorModel();  // 0.054 mm/px, the default response
-  const cv::Mat3b smooth = makeSyntheticBackground(truth.imageSize());
+  const cv::Mat3b smooth = makeSyntheticBackground(truth);
   const DigitShader shader(truth, smooth, BackgroundSource::kSynthetic);
   CalibrationInput input;
   const cv::Mat1f flat(truth.rows, truth.cols, 0.0f);
@@ -225,7 +225,7 @@ TEST(Calibration, AMarkerGelsDotsAreMeasuredAndMaskedOutOfTheFit) {
   truth.markers.pitch_mm = 1.6;
   truth.markers.dot_diameter_mm = 0.45;
   truth.markers.darkness = 0.6;
-  const cv::Mat3b smooth = makeSyntheticBackground(truth.imageSize());
+  const cv::Mat3b smooth = makeSyntheticBackground(truth);
   const DigitShader shader(truth, smooth, BackgroundSource::kSynthetic);
   const MarkerPattern pattern(truth);
   std::vector<Marker> rest;
@@ -388,7 +388,7 @@ TEST(Calibration, RealPressesWithoutTheScaleAreFlaggedAsNotPinningIt) {
 
 TEST(Calibration, BadInputIsAClearError) {
   const SensorModel m = makeDigitSensorModel();
-  const cv::Mat3b smooth = makeSyntheticBackground(m.imageSize());
+  const cv::Mat3b smooth = makeSyntheticBackground(m);
   const DigitShader shader(m, smooth, BackgroundSource::kSynthetic);
   CalibrationInput good;
   good.backgrounds.push_back({"bg.png", smooth});
@@ -430,7 +430,7 @@ TEST(Calibration, BadInputIsAClearError) {
 // in pixels and the ball's radius.
 TEST(Calibration, AGivenScaleIsUsedAsGivenOrRefusedNamingThePress) {
   const SensorModel m = makeDigitSensorModel();
-  const cv::Mat3b smooth = makeSyntheticBackground(m.imageSize());
+  const cv::Mat3b smooth = makeSyntheticBackground(m);
   const DigitShader shader(m, smooth, BackgroundSource::kSynthetic);
   CalibrationInput input;
   input.backgrounds.push_back({"bg.png", smooth});

@@ -348,7 +348,7 @@ TEST(ConformityRender, OffIsTheFixedDepthOverlayBitForBit) {
   const ContactRasterizer rasterizer(model);
   const TextureOverlay overlay(atlas, beta);
   const GelModel gel(model);
-  const DigitShader shader(model, makeSyntheticBackground(model.imageSize()),
+  const DigitShader shader(model, makeSyntheticBackground(model),
                            BackgroundSource::kSynthetic);
   for (double press_mm : {0.3, 1.0}) {
     const auto pose = poseMm(0.7, -1.1, 5.0 - press_mm);
@@ -410,7 +410,7 @@ TEST(ConformityRender, OnIsTheStagesInARowWithTheFollowedRelief) {
   const TextureOverlay overlay(atlas, beta);
   GelConformity conformity(model.conformity, model.mm_per_pixel);
   const GelModel gel(model);
-  const DigitShader shader(model, makeSyntheticBackground(model.imageSize()),
+  const DigitShader shader(model, makeSyntheticBackground(model),
                            BackgroundSource::kSynthetic);
   for (double press_mm : {0.3, 1.0}) {
     const auto pose = poseMm(0.7, -1.1, 5.0 - press_mm);

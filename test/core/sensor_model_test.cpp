@@ -1,11 +1,14 @@
 #include <cmath>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader_response.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/render/synthetic_background.hpp"
 #include "test_helpers.hpp"
 
 namespace norm2tex {
@@ -160,6 +163,81 @@ TEST(SensorModel, MarkersAndShearLoadSaveAndRejectBadValues) {
   expectBad("markers: {pitch: 1}\n", {"unknown key 'markers.pitch'"});
   expectBad("shear: {shear_modulus_mpa: -1}\n", {"shear.shear_modulus_mpa", "(0, 100] MPa"});
   expectBad("shear: {friction: .nan}\n", {"shear.friction"});
+}
+
+// The synthetic frame's look: the DIGIT's by default (a yaml without the section keeps it), a
+// yaml's own replaces it (its glows the whole list), saved and loaded back, bad values named.
+TEST(SensorModel, SyntheticBackgroundLoadsSavesAndRejectsBadValues) {
+  test::ScratchDirectory dir;
+  const SyntheticBackgroundOptions digit;
+  ASSERT_EQ(digit.glows.size(), 4u);
+  std::ofstream(dir.path("none.yaml")) << "image: {mm_per_pixel: 0.05}\n";
+  const SensorModel without = loadSensorModel(dir.path("none.yaml"));
+  EXPECT_EQ(without.synthetic_background.base_bgr, digit.base_bgr);
+  ASSERT_EQ(without.synthetic_background.glows.size(), 4u);
+  EXPECT_EQ(without.synthetic_background.glows[2].centre_uv, digit.glows[2].centre_uv);
+  // digit.yaml spells the defaults out.
+  const SyntheticBackgroundOptions shipped =
+      loadSensorModel(NORM2TEX_SOURCE_DIR "/config/digit.yaml").synthetic_background;
+  EXPECT_EQ(shipped.base_bgr, digit.base_bgr);
+  EXPECT_EQ(shipped.vignette_strength, digit.vignette_strength);
+  EXPECT_EQ(shipped.vignette_power, digit.vignette_power);
+  ASSERT_EQ(shipped.glows.size(), digit.glows.size());
+  for (std::size_t j = 0; j < digit.glows.size(); ++j) {
+    EXPECT_EQ(shipped.glows[j].centre_uv, digit.glows[j].centre_uv) << j;
+    EXPECT_EQ(shipped.glows[j].sigma_uv, digit.glows[j].sigma_uv) << j;
+    EXPECT_EQ(shipped.glows[j].angle_rad, digit.glows[j].angle_rad) << j;
+    EXPECT_EQ(shipped.glows[j].color_bgr, digit.glows[j].color_bgr) << j;
+  }
+
+  std::ofstream(dir.path("own.yaml"))
+      << "synthetic_background:\n  base_bgr: [10, 20, 30]\n  vignette_strength: 0.5\n"
+         "  glows:\n    - {centre_uv: [0.25, 1.5], sigma_uv: [0.5, 0.125], angle_rad: -0.75,\n"
+         "       color_bgr: [40, 0, 60]}\n";
+  SensorModel m = loadSensorModel(dir.path("own.yaml"));
+  EXPECT_EQ(m.synthetic_background.base_bgr, cv::Vec3d(10, 20, 30));
+  EXPECT_DOUBLE_EQ(m.synthetic_background.vignette_strength, 0.5);
+  EXPECT_DOUBLE_EQ(m.synthetic_background.vignette_power, digit.vignette_power);  // not given
+  ASSERT_EQ(m.synthetic_background.glows.size(), 1u);
+  EXPECT_EQ(m.synthetic_background.glows[0].centre_uv, (std::array<double, 2>{0.25, 1.5}));
+  EXPECT_DOUBLE_EQ(m.synthetic_background.glows[0].angle_rad, -0.75);
+  saveSensorModel(m, dir.path("saved.yaml"));
+  const SyntheticBackgroundOptions loaded =
+      loadSensorModel(dir.path("saved.yaml")).synthetic_background;
+  EXPECT_EQ(loaded.base_bgr, m.synthetic_background.base_bgr);
+  ASSERT_EQ(loaded.glows.size(), 1u);
+  EXPECT_EQ(loaded.glows[0].sigma_uv, m.synthetic_background.glows[0].sigma_uv);
+  EXPECT_EQ(loaded.glows[0].color_bgr, m.synthetic_background.glows[0].color_bgr);
+  // No glows at all: a plain vignetted base, saved as an empty list.
+  m.synthetic_background.glows.clear();
+  saveSensorModel(m, dir.path("plain.yaml"));
+  EXPECT_TRUE(loadSensorModel(dir.path("plain.yaml")).synthetic_background.glows.empty());
+
+  const auto expectBad = [&](const std::string& yaml, std::vector<std::string> words) {
+    std::ofstream(dir.path("bad.yaml")) << yaml;
+    test::expectError([&] { loadSensorModel(dir.path("bad.yaml")); }, words);
+  };
+  const std::string glow = "centre_uv: [0.5, 0.5], sigma_uv: [0.2, 0.2], angle_rad: 0, ";
+  expectBad("synthetic_background: {base_bgr: [0, 300, 0]}\n",
+            {"bad.yaml", "synthetic_background.base_bgr", "[0, 255]"});
+  expectBad("synthetic_background: {vignette_strength: 1}\n",
+            {"synthetic_background.vignette_strength", "[0, 1)"});
+  expectBad("synthetic_background: {vignette_power: 0}\n", {"synthetic_background.vignette_power"});
+  expectBad("synthetic_background: {glows: {centre_uv: [0, 0]}}\n", {"a list of glows"});
+  expectBad("synthetic_background: {glows: [{centre_uv: [0.5, 0.5]}]}\n",
+            {"synthetic_background.glows[0] needs sigma_uv"});
+  expectBad("synthetic_background: {glows: [{" + glow + "color_bgr: [0, 0, 9]}, {" + glow +
+                "color_bgr: [0, -1, 0]}]}\n",
+            {"synthetic_background.glows[1].color_bgr", "[0, 255]"});
+  expectBad("synthetic_background: {glows: [{" + glow + "color_bgr: [0, 0]}]}\n",
+            {"synthetic_background.glows[0].color_bgr", "3 numbers"});
+  expectBad("synthetic_background: {glows: [{centre_uv: [0.5, 0.5], sigma_uv: [0, 0.2], "
+            "angle_rad: 0, color_bgr: [1, 1, 1]}]}\n",
+            {"synthetic_background.glows[0].sigma_uv", "(0, 10]"});
+  expectBad("synthetic_background: {glows: [{" + glow + "color_bgr: [1, 1, 1], colour: 1}]}\n",
+            {"unknown key 'synthetic_background.glows[].colour'"});
+  expectBad("synthetic_background: {base: [1, 1, 1]}\n",
+            {"unknown key 'synthetic_background.base'"});
 }
 
 TEST(SensorModel, PixelCentresMapToTheGelFrame) {

@@ -96,6 +96,8 @@ SensorModel analyticModel(bool vga = false) {
 }
 
 constexpr BackgroundSource kSynthetic = BackgroundSource::kSynthetic;
+// The DIGIT's synthetic look (the defaults), for frames of a size of their own.
+const SyntheticBackgroundOptions kDigitLook;
 
 // Standard deviation of `frame` minus its Gaussian blur (sigma 3 px), per channel pooled: the
 // measure of pixel noise used on real DIGIT frames.
@@ -112,7 +114,7 @@ double highPassNoise(const cv::Mat3b& frame) {
 class ShaderTest : public ::testing::Test {
  protected:
   SensorModel model = makeDigitSensorModel();
-  cv::Mat3b background = makeSyntheticBackground(model.imageSize());
+  cv::Mat3b background = makeSyntheticBackground(model);
   DigitShader shader{model, background, kSynthetic};
   cv::Mat1f flat = cv::Mat1f(model.rows, model.cols, 0.0f);
 };
@@ -298,17 +300,17 @@ void expectLedSides(const SensorModel& model, const DigitShader& shader, const c
 TEST(ShaderLedTest, EachLedLightsTheSideOfAPressFacingIt) {
   const SensorModel analytic = analyticModel();
   expectLedSides(analytic,
-                 DigitShader(analytic, makeSyntheticBackground(analytic.imageSize()), kSynthetic),
+                 DigitShader(analytic, makeSyntheticBackground(analytic), kSynthetic),
                  sphericalCap(analytic, 3.0, 0.5));
 }
 
 TEST(ShaderLedTest, EachLedLightsTheSideFacingItAtVgaAndOnADome) {
   const SensorModel vga = analyticModel(true);
-  expectLedSides(vga, DigitShader(vga, makeSyntheticBackground(vga.imageSize()), kSynthetic),
+  expectLedSides(vga, DigitShader(vga, makeSyntheticBackground(vga), kSynthetic),
                  sphericalCap(vga, 3.0, 0.5));
   SensorModel dome = analyticModel();
   dome.gel_curvature_radius_mm = 100.0;
-  const DigitShader dome_shader(dome, makeSyntheticBackground(dome.imageSize()), kSynthetic);
+  const DigitShader dome_shader(dome, makeSyntheticBackground(dome), kSynthetic);
   EXPECT_TRUE(identical(dome_shader.shade(cv::Mat1f(dome.rows, dome.cols, 0.0f), -1),
                         dome_shader.background()));
   expectLedSides(dome, dome_shader, sphericalCap(dome, 3.0, 0.5));
@@ -322,7 +324,7 @@ TEST(ShaderLedTest, EachLedLightsTheSideFacingItAtVgaAndOnADome) {
 // calibrate_test.)
 TEST(ShaderLedTest, AnalyticBallPressHasRealisticMagnitudes) {
   const SensorModel model = analyticModel();
-  const cv::Mat3b background = makeSyntheticBackground(model.imageSize());
+  const cv::Mat3b background = makeSyntheticBackground(model);
   const DigitShader shader(model, background, kSynthetic);
   const cv::Mat1f raw = sphericalCap(model, 4.4, 1.5);
   cv::Mat1f h;
@@ -354,7 +356,7 @@ TEST(ShaderLedTest, AnalyticBallPressHasRealisticMagnitudes) {
 TEST_F(ShaderTest, SlopesAreScaleInvariantAcrossResolutions) {
   // The same press at VGA (half the mm per pixel) looks the same: slopes use mm over mm.
   const SensorModel vga = makeDigitSensorModel(true);
-  const DigitShader vga_shader(vga, makeSyntheticBackground(vga.imageSize()), kSynthetic);
+  const DigitShader vga_shader(vga, makeSyntheticBackground(vga), kSynthetic);
   const cv::Mat1f qvga_raw = sphericalCap(model, 4.4, 1.0), vga_raw = sphericalCap(vga, 4.4, 1.0);
   const double qvga_mean =
       meanAbs(shader.shadingDifference(smoothed(qvga_raw, model, 0.3)), qvga_raw > 0.0f);
@@ -486,7 +488,7 @@ TEST(ShaderResponseTest, SaturatedSlopesAreTheNormalsComponents) {
 // feature in that channel, the others stay 0; the response is linear.
 TEST(ShaderResponseTest, ShaderAppliesTheResponseToTheFeatures) {
   SensorModel model = makeDigitSensorModel();
-  const cv::Mat3b background = makeSyntheticBackground(model.imageSize());
+  const cv::Mat3b background = makeSyntheticBackground(model);
   const cv::Mat1f h = smoothed(sphericalCap(model, 3.0, 0.4, 1.0, 2.0), model, 0.2);
   ShadingFeatureArray f;
   const cv::Rect box(0, 0, model.cols, model.rows);
@@ -513,7 +515,7 @@ TEST(ShaderResponseTest, ShaderAppliesTheResponseToTheFeatures) {
 // (typical of the calibration set).
 TEST(ShaderResponseTest, CalibratedBallPressLooksLikeARealOne) {
   const SensorModel model = makeDigitSensorModel();
-  const DigitShader shader(model, makeSyntheticBackground(model.imageSize()), kSynthetic);
+  const DigitShader shader(model, makeSyntheticBackground(model), kSynthetic);
   const GelModel gel_model(model);
   for (const cv::Point2d centre_mm : {cv::Point2d(0, 0), cv::Point2d(-2, 3), cv::Point2d(2, -3)}) {
     const double ball = 3.0, contact = 1.5;
@@ -591,29 +593,31 @@ void expectRealisticBackground(const cv::Mat3b& bg) {
 }
 
 TEST(BackgroundTest, SyntheticBackgroundLooksLikeARealDigitFrame) {
-  const cv::Mat3b qvga = makeSyntheticBackground({240, 320});
+  const cv::Mat3b qvga = makeSyntheticBackground(kDigitLook, {240, 320});
   ASSERT_EQ(qvga.size(), cv::Size(240, 320));
   expectRealisticBackground(qvga);
-  EXPECT_TRUE(identical(qvga, makeSyntheticBackground({240, 320})));  // deterministic
+  EXPECT_TRUE(identical(qvga, makeSyntheticBackground(kDigitLook, {240, 320})));  // deterministic
 }
 
 TEST(BackgroundTest, SyntheticBackgroundWorksAtVgaAndMatchesQvga) {
-  const cv::Mat3b vga = makeSyntheticBackground({480, 640});
+  const cv::Mat3b vga = makeSyntheticBackground(kDigitLook, {480, 640});
   ASSERT_EQ(vga.size(), cv::Size(480, 640));
   expectRealisticBackground(vga);
   cv::Mat3b down;
   cv::resize(vga, down, {240, 320}, 0, 0, cv::INTER_AREA);
-  EXPECT_LT(meanAbs(difference(down, makeSyntheticBackground({240, 320})), cv::Mat1b()), 1.0);
-  EXPECT_THROW(makeSyntheticBackground({0, 10}), Error);
+  EXPECT_LT(meanAbs(difference(down, makeSyntheticBackground(kDigitLook, {240, 320})), cv::Mat1b()),
+            1.0);
+  EXPECT_THROW(makeSyntheticBackground(kDigitLook, {0, 10}), Error);
 }
 
 // --- bad input and loading -----------------------------------------------------------------
 
 TEST_F(ShaderTest, RejectsBackgroundAndHeightOfTheWrongSize) {
   EXPECT_THROW(DigitShader(model, cv::Mat3b(), kSynthetic), Error);
-  EXPECT_THROW(DigitShader(model, makeSyntheticBackground({320, 240}), kSynthetic),
+  EXPECT_THROW(DigitShader(model, makeSyntheticBackground(kDigitLook, {320, 240}), kSynthetic),
                Error);  // landscape
-  EXPECT_THROW(DigitShader(model, makeSyntheticBackground({480, 640}), kSynthetic), Error);
+  EXPECT_THROW(DigitShader(model, makeSyntheticBackground(kDigitLook, {480, 640}), kSynthetic),
+               Error);
   SensorModel broken = model;
   broken.noise.sigma_bgr[1] = -1.0;
   EXPECT_TRUE(messageContains([&] { const DigitShader bad(broken, background, kSynthetic); },
@@ -662,11 +666,12 @@ TEST(BackgroundTest, LoadsGray16BitBgraAndResizes) {
                         cv::Mat3b(size, cv::Vec3b(30, 60, 90))));
 
   // A VGA frame for a QVGA model is resized; a smooth one stays the same at half size.
-  const cv::Mat3b vga = makeSyntheticBackground({480, 640});
+  const cv::Mat3b vga = makeSyntheticBackground(kDigitLook, {480, 640});
   ASSERT_TRUE(cv::imwrite(dir.path("vga.png"), vga));
   const cv::Mat3b loaded = loadBackground(dir.path("vga.png"), size);
   ASSERT_EQ(loaded.size(), size);
-  EXPECT_LT(meanAbs(difference(loaded, makeSyntheticBackground(size)), cv::Mat1b()), 1.0);
+  EXPECT_LT(meanAbs(difference(loaded, makeSyntheticBackground(kDigitLook, size)), cv::Mat1b()),
+            1.0);
 
   // A loaded background drives the shader.
   const SensorModel model = makeDigitSensorModel();
@@ -695,7 +700,7 @@ TEST(BackgroundTest, BadFilesThrowErrorsNamingTheFile) {
   // A frame the driver did not rotate (landscape for a portrait sensor) is refused, not
   // silently stretched.
   const std::string landscape = dir.path("landscape.png");
-  ASSERT_TRUE(cv::imwrite(landscape, makeSyntheticBackground({320, 240})));
+  ASSERT_TRUE(cv::imwrite(landscape, makeSyntheticBackground(kDigitLook, {320, 240})));
   test::expectError([&] { loadBackground(landscape, size); }, {landscape, "landscape", "rotate"});
 }
 

@@ -34,7 +34,7 @@ class CalibrateCli : public norm2tex::test::CliTest {
   void SetUp() override {
     CliTest::SetUp();
     const norm2tex::SensorModel m = norm2tex::makeDigitSensorModel();
-    const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m.imageSize()),
+    const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m),
                                        norm2tex::BackgroundSource::kSynthetic);
     const cv::Mat1f flat(m.rows, m.cols, 0.0f);
     cv::imwrite(path("bg.png"), shader.shade(flat, 1));
@@ -135,7 +135,7 @@ TEST_F(CalibrateCli, JudgeRendersAGivenSensorOnThePressesWithoutFitting) {
 // given; the scale is given once.
 TEST_F(CalibrateCli, TwoPressesAKnownDistanceApartGiveTheScale) {
   const norm2tex::SensorModel m = norm2tex::makeDigitSensorModel();
-  const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m.imageSize()),
+  const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m),
                                      norm2tex::BackgroundSource::kSynthetic);
   for (const double x_mm : {-4.0, 4.0}) {
     const norm2tex::PressCircle circle{{x_mm / m.mm_per_pixel + 119.5, 159.5},

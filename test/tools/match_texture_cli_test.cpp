@@ -49,7 +49,7 @@ class MatchTextureCli : public norm2tex::test::CliTest {
     // (the coating holds them back under the sensor's noise: texture_match_test covers that).
     model.conformity.coating_length_mm = 0.0;
     norm2tex::saveSensorModel(model, path("sensor.yaml"));
-    const cv::Mat3b background = norm2tex::makeSyntheticBackground(model.imageSize());
+    const cv::Mat3b background = norm2tex::makeSyntheticBackground(model);
     cv::imwrite(path("bg.png"), background);
     // The shipped fabric, as the tool finds it (config/materials/fabric.yaml of the source tree).
     norm2tex::MaterialConfig config =

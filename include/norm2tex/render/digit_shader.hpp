@@ -9,18 +9,9 @@
 
 #include "norm2tex/render/digit_shader_noise.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/render/synthetic_background.hpp"
 
 namespace norm2tex {
-
-/// A synthetic DIGIT no-contact frame of `size` that resembles a real one: reddish upper-left,
-/// green on the right, blue-violet lower side, smooth vignetting, mean BGR near (99, 105, 99).
-/// Deterministic (no noise). Built from four smooth Gaussian glows, a base level and a radial
-/// vignette in normalised coordinates, so any size works. Targets vs reached (BGR means, thirds
-/// of the image): global (99, 105, 99) -> (98.5, 105.1, 99.0); top-left (117, 106, 133) ->
-/// (114.6, 101.7, 132.6); top-right (105, 117, 73) -> (103.4, 116.4, 75.3); bottom-centre
-/// (98, 92, 70) -> (97.7, 92.5, 66.6); centre (102, 123, 134) -> (103.6, 120.7, 130.5).
-/// Throws Error for a non-positive size.
-cv::Mat3b makeSyntheticBackground(cv::Size size);
 
 /// The user's own no-contact frame, resized to the model's image size if needed. Accepts 8- or
 /// 16-bit, gray, BGR or BGRA; throws Error naming the file if it cannot be used, including a

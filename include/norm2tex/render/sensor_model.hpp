@@ -8,7 +8,7 @@
 
 namespace norm2tex {
 
-/// One of the DIGIT's three LEDs.
+/// One of the sensor's three LEDs (the analytic_leds shading).
 struct LedModel {
   std::string name;        ///< "red", "green", "blue"
   cv::Vec3d position_mm;   ///< in the gel frame (see SensorModel)
@@ -118,7 +118,33 @@ struct ShearOptions {
   double friction = 1.0;
 };
 
-/// Everything about one DIGIT that the renderer needs, loaded from config/digit.yaml.
+/// One smooth glow of the synthetic no-contact frame: an anisotropic Gaussian in normalised image
+/// coordinates (u = column / width, v = row / height, both 0..1 over the image), rotated.
+struct BackgroundGlow {
+  std::array<double, 2> centre_uv{0.5, 0.5};  ///< may lie outside 0..1 (a glow from past an edge)
+  std::array<double, 2> sigma_uv{0.25, 0.25};  ///< along the glow's own axes a and b, > 0
+  double angle_rad = 0.0;                      ///< axis a from +u towards +v
+  cv::Vec3d color_bgr{0.0, 0.0, 0.0};          ///< grey levels at its peak, before vignetting
+};
+
+/// The DIGIT's four glows (fitted to a real DIGIT's no-contact frame; synthetic_background.cpp).
+std::vector<BackgroundGlow> digitBackgroundGlows();
+
+/// How the synthetic no-contact frame looks, used when background_image is empty:
+///   I_bgr(u, v) = vignette(u, v) * (base_bgr + sum_j color_j * glow_j(u, v)),
+///   vignette = 1 - vignette_strength * (r / r_corner)^vignette_power
+/// in normalised coordinates, so it looks the same at any size of the same aspect. The defaults
+/// are the DIGIT's (makeSyntheticBackground says what they reach); another sensor's yaml gives
+/// its own (config/gelsight_mini.yaml).
+struct SyntheticBackgroundOptions {
+  cv::Vec3d base_bgr{59.0, 83.9, 47.8};  ///< grey levels everywhere, before vignetting
+  double vignette_strength = 0.30;       ///< brightness lost in the corners, [0, 1)
+  double vignette_power = 2.2;           ///< how fast it falls towards them, > 0
+  std::vector<BackgroundGlow> glows = digitBackgroundGlows();
+};
+
+/// Everything about one sensor that the renderer needs, loaded from its yaml (config/digit.yaml,
+/// config/gelsight_mini.yaml). The defaults are a DIGIT's.
 ///
 /// Gel frame (shared by the CLI, the tests and the ROS nodes): origin at the centre of the
 /// undeformed gel surface; +x towards increasing image columns (right); +y towards increasing
@@ -144,6 +170,7 @@ struct SensorModel {
   ShadingOptions shading;
   NoiseOptions noise;
   std::string background_image;  ///< user's no-contact frame (BGR); empty = synthetic
+  SyntheticBackgroundOptions synthetic_background;  ///< the synthetic frame's look
   GelOptions gel;
   ConformityOptions conformity;
   MarkerOptions markers;
@@ -160,7 +187,8 @@ struct SensorModel {
 /// Defaults for a DIGIT at QVGA (320 x 240) or VGA (640 x 480): same gel, halved mm per pixel.
 SensorModel makeDigitSensorModel(bool vga = false);
 
-/// Loads config/digit.yaml (every key optional, defaults above; `preset: qvga|vga` first).
+/// Loads a sensor yaml such as config/digit.yaml (every key optional, defaults above; `preset:
+/// qvga|vga` first).
 /// A relative background_image is resolved against the yaml's directory. Throws Error naming
 /// the file and key for unreadable yaml, an unknown key (a typo would otherwise be ignored
 /// silently) or a value out of range.

@@ -14,6 +14,7 @@
 #include "common/error_messages.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader_response.hpp"
+#include "norm2tex/render/synthetic_background.hpp"
 
 namespace norm2tex {
 namespace {
@@ -35,7 +36,7 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
   static const std::map<std::string, std::set<std::string>> keys = {
       {"",
        {"preset", "image", "gel", "camera", "leds", "shading", "noise", "background_image",
-        "gel_model", "conformity", "markers", "shear"}},
+        "synthetic_background", "gel_model", "conformity", "markers", "shear"}},
       {"image", {"rows", "cols", "mm_per_pixel"}},
       {"gel", {"thickness_mm", "curvature_radius_mm", "pad_width_mm", "pad_height_mm"}},
       {"camera", {"fx", "fy", "cx", "cy"}},
@@ -51,6 +52,8 @@ const std::set<std::string>& allowedKeys(const std::string& section) {
        {"enabled", "rows", "cols", "pitch_mm", "dot_diameter_mm", "darkness", "blur_mm",
         "jitter_mm", "seed", "offset_mm"}},
       {"shear", {"shear_modulus_mpa", "friction"}},
+      {"synthetic_background", {"base_bgr", "vignette_strength", "vignette_power", "glows"}},
+      {"synthetic_background.glows[]", {"centre_uv", "sigma_uv", "angle_rad", "color_bgr"}},
   };
   return keys.at(section);
 }
@@ -149,6 +152,40 @@ void readMarkers(const YAML::Node& node, MarkerOptions& markers) {
     if (values.size() != 2)
       throw Error("markers.offset_mm needs 2 numbers, got " + std::to_string(values.size()));
     markers.offset_mm = {values[0], values[1]};
+  }
+}
+
+std::array<double, 2> readPair(const YAML::Node& node, const std::string& key) {
+  const std::vector<double> values = node.as<std::vector<double>>();
+  if (values.size() != 2)
+    throw Error(key + " needs 2 numbers, got " + std::to_string(values.size()));
+  return {values[0], values[1]};
+}
+
+// A given glows list replaces the default one whole, and every glow gives all four keys: a glow
+// half taken from the defaults would be a glow nobody measured.
+void readSyntheticBackground(const YAML::Node& node, SyntheticBackgroundOptions& look) {
+  if (!node) return;
+  rejectUnknownKeys(node, "synthetic_background");
+  if (node["base_bgr"]) look.base_bgr = readVec3(node["base_bgr"], "synthetic_background.base_bgr");
+  read(node, "vignette_strength", look.vignette_strength);
+  read(node, "vignette_power", look.vignette_power);
+  const YAML::Node glows = node["glows"];
+  if (!glows) return;
+  if (!glows.IsSequence()) throw Error("synthetic_background.glows must be a list of glows");
+  look.glows.clear();
+  for (std::size_t j = 0; j < glows.size(); ++j) {
+    const std::string name = "synthetic_background.glows[" + std::to_string(j) + "]";
+    rejectUnknownKeys(glows[j], "synthetic_background.glows[]");
+    for (const char* key : {"centre_uv", "sigma_uv", "angle_rad", "color_bgr"}) {
+      if (!glows[j][key]) throw Error(name + " needs " + key);
+    }
+    BackgroundGlow glow;
+    glow.centre_uv = readPair(glows[j]["centre_uv"], name + ".centre_uv");
+    glow.sigma_uv = readPair(glows[j]["sigma_uv"], name + ".sigma_uv");
+    glow.angle_rad = glows[j]["angle_rad"].as<double>();
+    glow.color_bgr = readVec3(glows[j]["color_bgr"], name + ".color_bgr");
+    look.glows.push_back(glow);
   }
 }
 
@@ -278,6 +315,7 @@ void validate(const SensorModel& m) {
   requireParameter(m.conformity.coating_length_mm >= 0.0 && m.conformity.coating_length_mm <= 2.0,
                    "conformity.coating_length_mm", m.conformity.coating_length_mm, "[0, 2] mm");
   validateMarkers(m);
+  validate(m.synthetic_background);
 }
 
 SensorModel loadSensorModel(const std::string& yaml_path) {
@@ -325,6 +363,7 @@ SensorModel loadSensorModel(const std::string& yaml_path) {
     readShading(root["shading"], m.shading);
     readNoise(root["noise"], m.noise);
     read(root, "background_image", m.background_image);
+    readSyntheticBackground(root["synthetic_background"], m.synthetic_background);
     if (const YAML::Node gel = root["gel_model"]) {
       rejectUnknownKeys(gel, "gel_model");
       read(gel, "pyramid_sigmas_mm", m.gel.pyramid_sigmas_mm);
@@ -370,7 +409,7 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
   validate(m);
   std::ostringstream out;
   out << std::setprecision(9);
-  out << "# DIGIT sensor model for norm2tex (see config/digit.yaml for what each key means).\n"
+  out << "# Sensor model for norm2tex (see config/digit.yaml for what each key means).\n"
       << "# Lengths in mm, images in pixels, grey levels of 255; colours in OpenCV BGR order.\n"
       << "image:\n  rows: " << m.rows << "\n  cols: " << m.cols
       << "\n  mm_per_pixel: " << m.mm_per_pixel << "\n"
@@ -404,7 +443,16 @@ void saveSensorModel(const SensorModel& m, const std::string& yaml_path) {
       << "\n  correlation_br: " << m.noise.correlation_br
       << "\n  on_real_background: " << (m.noise.on_real_background ? "true" : "false") << "\n"
       << "background_image: \"" << m.background_image << "\"\n"
-      << "gel_model:\n  pyramid_sigmas_mm: [";
+      << "synthetic_background:\n  base_bgr: " << vec3(m.synthetic_background.base_bgr)
+      << "\n  vignette_strength: " << m.synthetic_background.vignette_strength
+      << "\n  vignette_power: " << m.synthetic_background.vignette_power << "\n  glows:"
+      << (m.synthetic_background.glows.empty() ? " []\n" : "\n");
+  for (const BackgroundGlow& g : m.synthetic_background.glows) {
+    out << "    - centre_uv: [" << g.centre_uv[0] << ", " << g.centre_uv[1] << "]\n"
+        << "      sigma_uv: [" << g.sigma_uv[0] << ", " << g.sigma_uv[1] << "]\n"
+        << "      angle_rad: " << g.angle_rad << "\n      color_bgr: " << vec3(g.color_bgr) << "\n";
+  }
+  out << "gel_model:\n  pyramid_sigmas_mm: [";
   for (size_t i = 0; i < m.gel.pyramid_sigmas_mm.size(); ++i) {
     out << (i ? ", " : "") << m.gel.pyramid_sigmas_mm[i];
   }

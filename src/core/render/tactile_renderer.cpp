@@ -11,7 +11,7 @@ namespace {
 
 cv::Mat3b backgroundFor(const SensorModel& model) {
   validate(model);
-  return model.background_image.empty() ? makeSyntheticBackground(model.imageSize())
+  return model.background_image.empty() ? makeSyntheticBackground(model)
                                         : loadBackground(model.background_image, model.imageSize());
 }
 

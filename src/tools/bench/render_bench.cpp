@@ -178,7 +178,7 @@ void BM_Stage_Conformity(benchmark::State& state) {
 }
 void BM_Stage_Shading(benchmark::State& state) {
   StageFixture f(state.range(0) != 0);
-  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()),
+  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model),
                                norm2tex::BackgroundSource::kSynthetic);
   const bool noise = state.range(1) != 0;
   std::int64_t seed = 0;
@@ -198,7 +198,7 @@ void BM_Render_HeldCube_Stages(benchmark::State& state) {
   norm2tex::ConformityOptions options;
   options.enabled = true;
   norm2tex::GelConformity conformity(options, f.model.mm_per_pixel);
-  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model.imageSize()),
+  norm2tex::DigitShader shader(f.model, norm2tex::makeSyntheticBackground(f.model),
                                norm2tex::BackgroundSource::kSynthetic);
   cv::Mat1f h_local;
   using Clock = std::chrono::steady_clock;

@@ -27,7 +27,7 @@ void shadingLoop(benchmark::State& state, norm2tex::ShadingKind kind, bool noise
   model.shading.kind = kind;
   const cv::Mat1f gel = pressGel(model, state.range(0) != 0);
   const norm2tex::DigitShader shader(
-      model, norm2tex::makeSyntheticBackground(model.imageSize()),
+      model, norm2tex::makeSyntheticBackground(model),
       noise ? norm2tex::BackgroundSource::kSynthetic : norm2tex::BackgroundSource::kCaptured);
   std::int64_t seed = 0;
   for (auto _ : state) {
