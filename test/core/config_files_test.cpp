@@ -17,7 +17,7 @@ namespace {
 
 TEST(ConfigFilesTest, EveryShippedYamlLoads) {
   const std::filesystem::path config = std::filesystem::path(NORM2TEX_SOURCE_DIR) / "config";
-  int loaded = 0;
+  int loaded = 0, sensors = 0;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(config)) {
     if (entry.path().extension() != ".yaml") continue;
     const std::string path = entry.path().string();
@@ -34,14 +34,17 @@ TEST(ConfigFilesTest, EveryShippedYamlLoads) {
         hand.hand = loadHandConfig(path);
         HandSim sim(hand);
       });
-    } else if (entry.path().filename() == "digit.yaml") {
+    } else if (folder == "config") {
+      // The sensor yamls (digit.yaml, gelsight_mini.yaml) sit at the top.
       EXPECT_NO_THROW(loadSensorModel(path));
+      ++sensors;
     } else {
       ADD_FAILURE() << "no loader knows " << path << ": add it to this test";
     }
     ++loaded;
   }
-  EXPECT_GE(loaded, 9);  // digit, 5 materials, 2 scenes, the built-in hand
+  EXPECT_GE(sensors, 2);  // digit, gelsight_mini
+  EXPECT_GE(loaded, 10);  // and 5 materials, 2 scenes, the built-in hand
 }
 
 // Shipped Python scripts run on the user's python3, found on PATH: `#!/usr/bin/python3` would
