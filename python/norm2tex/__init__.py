@@ -6,8 +6,10 @@ package) costs nothing extra and works where the module was not built.
 
 Units: metres for poses and positions, millimetres where a name ends in ``_mm``, newtons for
 forces. Poses are 4x4 homogeneous matrices (numpy float64) or ``(xyz, quaternion_xyzw)`` pairs;
-poses returned are 4x4 matrices. Images are numpy arrays: bgr8 ``(320, 240, 3) uint8`` as the
-DIGIT publishes them, depth ``(320, 240) float32`` in metres, masks ``(320, 240) uint8``.
+poses returned are 4x4 matrices. Images are numpy arrays of the sensor's size, rows x cols as
+its yaml gives them: bgr8 ``(rows, cols, 3) uint8`` as the sensor publishes them, depth
+``(rows, cols) float32`` in metres, masks ``(rows, cols) uint8`` ((320, 240) for a DIGIT,
+(240, 320) for the GelSight Mini profile, ``config_path("gelsight_mini.yaml")``).
 
     import norm2tex
     sensor = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))

@@ -3,7 +3,7 @@ of ``scripts/train_material_classifier`` (needs PyTorch, and torchvision for Res
 on its own, not by ``import norm2tex``).
 
 The input is a background-subtracted frame (``ExportedDataset(image="diff")``: float grey
-levels, 3 x 320 x 240 BGR for a QVGA DIGIT), averaged over ``downscale`` x ``downscale`` pixel
+levels, 3 x rows x cols BGR: 3 x 320 x 240 for a QVGA DIGIT), averaged over ``downscale`` x ``downscale`` pixel
 blocks before the network. At 0.053 mm/px a 4x average has 0.21 mm pixels, the period of a
 0.2 mm 3-D print layer: averaging removes every pattern whose period is not longer than the
 block (a 2-px stripe vanishes at 2x and 4x), so ``downscale`` sets what the classifier can see.

@@ -135,6 +135,31 @@ def test_a_shear_load_moves_the_gel_and_its_markers_from_python(sensor):
         renderer.render(pose, shear=norm2tex.ShearLoad((float("nan"), 0.0)))
 
 
+def test_a_gelsight_mini_press_is_landscape_and_equals_the_cli_frame(tmp_path):
+    """The second sensor from Python: its yaml's size, grid and gel, the press under the ball,
+    and the very frame norm2tex_render --sensor draws."""
+    mini = norm2tex.SensorModel.load(norm2tex.config_path("gelsight_mini.yaml"))
+    assert (mini.rows, mini.cols) == (240, 320)
+    assert mini.markers_enabled and mini.shear_modulus_mpa == pytest.approx(0.145)
+    renderer = norm2tex.TactileRenderer(mini)
+    renderer.set_object(norm2tex.load_object_mesh("sphere:4")["mesh"])
+    frame = renderer.render(pose_matrix(0.002, -0.001, 0.004 - 1e-3, 0, 0, 0), noise_seed=3)
+    assert frame.image.shape == (240, 320, 3) and frame.depth.shape == (240, 320)
+    rows, cols = np.nonzero(frame.contact_mask)
+    assert cols.mean() == pytest.approx(159.5 + 2.0 / mini.mm_per_pixel, abs=1.5)
+    assert rows.mean() == pytest.approx(119.5 - 1.0 / mini.mm_per_pixel, abs=1.5)
+    assert frame.markers["rest_px"].shape == (63, 2)  # 7 x 9
+    tool = os.path.join(TOOLS_DIR, "norm2tex_render")
+    if not os.path.exists(tool):
+        pytest.skip("norm2tex_render not found in NORM2TEX_TOOLS_DIR=%r" % TOOLS_DIR)
+    out = str(tmp_path / "mini.png")
+    subprocess.run([tool, "--mesh", "sphere:4", "--pose", "0.002 -0.001 0.004 0 0 0",
+                    "--press-mm", "1", "--seed", "3", "--sensor",
+                    norm2tex.config_path("gelsight_mini.yaml"), "-o", out],
+                   check=True, capture_output=True)
+    np.testing.assert_array_equal(frame.image, read_png(out))
+
+
 def test_errors_carry_the_cpp_message(sensor, cube):
     with pytest.raises(norm2tex.Error, match="/no/such/mesh.obj"):
         norm2tex.load_object_mesh("/no/such/mesh.obj")

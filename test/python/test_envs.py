@@ -43,6 +43,20 @@ def test_spaces_contain_every_observation(kwargs):
     env.close()
 
 
+def test_a_gelsight_mini_gripper_observes_landscape_frames():
+    """sensor= takes any sensor yaml: the second one's 240 x 320 frames fill the spaces."""
+    env = GripperEnv(sensor=norm2tex.config_path("gelsight_mini.yaml"), image="diff_int16",
+                     downscale=4, depth=True)
+    obs, _ = env.reset(seed=3)
+    assert env.observation_space.contains(obs)
+    assert obs["digit_left"].shape == (240 // 4, 320 // 4, 3)
+    assert obs["depth_right"].shape == (240 // 4, 320 // 4)
+    for _ in range(3):
+        obs, *_ = env.step(0)  # close
+        assert env.observation_space.contains(obs)
+    env.close()
+
+
 def test_reset_with_a_seed_repeats_the_episode():
     env = HoldCubeEnv()
     actions = [2, 2, 1, 0, 2, 2, 2, 1, 2, 0] * 3

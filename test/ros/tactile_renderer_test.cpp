@@ -21,6 +21,7 @@
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
+#include "norm2tex/TactileMarkers.h"
 #include "norm2tex/render/digit_shader_response.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "run_node.hpp"
@@ -30,6 +31,8 @@ namespace {
 
 // The sensor the sync rostests launch (tactile_renderer_sync.test).
 const char* const kSensorYaml = NORM2TEX_SOURCE_DIR "/config/digit.yaml";
+// The second sensor, launched with sensor:= (gelsight_mini.test).
+const char* const kMiniYaml = NORM2TEX_SOURCE_DIR "/config/gelsight_mini.yaml";
 
 using norm2tex::waitFor;
 
@@ -202,6 +205,81 @@ TEST(RealTimeRendering, ContactShowsGrowsWithTheSqueezeAndEndsWhenDropped) {
     cv::absdiff(view(*s.image[held[sensor]]), view(*s.image[t]), diff);
     const cv::Scalar inside = cv::mean(diff, view(*s.mask[held[sensor]]));
     EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 5.0) << sensor;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// gripper_sim.launch sensor:=config/gelsight_mini.yaml (gelsight_mini.test): lock-step, noise off.
+
+TEST(GelSightMiniRendering, BothFingersPublishTheMinisLandscapeFramesAndCameraInfo) {
+  const norm2tex::SensorModel mini = norm2tex::loadSensorModel(kMiniYaml);
+  Listener l({"digit_left", "digit_right"});
+  std::map<std::string, sensor_msgs::Image::ConstPtr> backgrounds;
+  std::map<std::string, std::map<ros::Time, norm2tex::TactileMarkers::ConstPtr>> markers;
+  std::vector<ros::Subscriber> extra;
+  for (const std::string sensor : {"digit_left", "digit_right"}) {
+    extra.push_back(l.nh.subscribe<sensor_msgs::Image>(
+        sensor + "/background", 1,
+        [&backgrounds, sensor](const auto& m) { backgrounds[sensor] = m; }));
+    extra.push_back(l.nh.subscribe<norm2tex::TactileMarkers>(
+        sensor + "/markers", 100,
+        [&markers, sensor](const auto& m) { markers[sensor][m->header.stamp] = m; }));
+  }
+  ros::ServiceClient step = l.nh.serviceClient<norm2tex::Step>("/contact_sim/step");
+  ros::ServiceClient reset = l.nh.serviceClient<norm2tex::Reset>("/contact_sim/reset");
+  ASSERT_TRUE(step.waitForExistence(ros::Duration(60.0)));
+  ASSERT_TRUE(l.connected(1));
+  norm2tex::Reset episode;
+  episode.request.seed = 2;
+  episode.request.height_offset = 0.010;  // the cube's lower edge crosses the gels
+  ASSERT_TRUE(reset.call(episode));
+  norm2tex::Step srv;
+  srv.request.frames = 1;
+  ASSERT_TRUE(step.call(srv));
+  EXPECT_EQ(srv.response.missing_images, 0u);
+  const ros::Time t = srv.response.stamp;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const std::string sensor : {"digit_left", "digit_right"}) {
+          SensorLog& s = l.log[sensor];
+          if (!s.image.count(t) || !s.mask.count(t) || !s.depth.count(t) || !s.info.count(t) ||
+              !backgrounds.count(sensor) || !markers[sensor].count(t)) {
+            return false;
+          }
+        }
+        return true;
+      },
+      20.0));
+  for (const std::string sensor : {"digit_left", "digit_right"}) {
+    SCOPED_TRACE(sensor);
+    SensorLog& s = l.log[sensor];
+    const sensor_msgs::Image& image = *s.image[t];
+    EXPECT_EQ(image.encoding, "bgr8");
+    EXPECT_EQ(image.height, 240u);  // landscape, not the DIGIT's 320 x 240 portrait
+    EXPECT_EQ(image.width, 320u);
+    EXPECT_EQ(s.depth[t]->height, 240u);
+    EXPECT_EQ(s.depth[t]->width, 320u);
+    EXPECT_EQ(s.mask[t]->width, 320u);
+    EXPECT_EQ(backgrounds[sensor]->width, 320u);
+    const sensor_msgs::CameraInfo& info = *s.info[t];
+    EXPECT_EQ(info.height, 240u);
+    EXPECT_EQ(info.width, 320u);
+    EXPECT_DOUBLE_EQ(info.K[0], mini.fx);
+    EXPECT_DOUBLE_EQ(info.K[2], mini.cx);
+    EXPECT_DOUBLE_EQ(info.K[4], mini.fy);
+    EXPECT_DOUBLE_EQ(info.K[5], mini.cy);
+    // Its gel carries the 7 x 9 dots: their message comes with every frame.
+    const norm2tex::TactileMarkers& dots = *markers[sensor][t];
+    EXPECT_EQ(dots.rows, 7u);
+    EXPECT_EQ(dots.cols, 9u);
+    EXPECT_EQ(dots.rest_px.size(), 63u);
+    // The held cube shows: the frame differs from the no-contact frame inside the contact.
+    const cv::Mat mask = view(*s.mask[t]);
+    ASSERT_GT(cv::countNonZero(mask), 1000);
+    cv::Mat diff;
+    cv::absdiff(view(image), view(*backgrounds[sensor]), diff);
+    const cv::Scalar inside = cv::mean(diff, mask);
+    EXPECT_GT((inside[0] + inside[1] + inside[2]) / 3.0, 2.0);
   }
 }
 

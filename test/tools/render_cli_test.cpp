@@ -247,6 +247,45 @@ TEST_F(RenderCli, ShearMovesTheMarkersAndBadLoadsAreUsageErrors) {
   EXPECT_NE(friction.output.find("friction"), std::string::npos) << friction.output;
 }
 
+// The second sensor: --sensor config/gelsight_mini.yaml renders its landscape 320 x 240 frame,
+// the contact under the ball at its own scale, the press visible against its no-contact frame,
+// and its own 7 x 9 marker grid.
+TEST_F(RenderCli, AGelSightMiniPressIsLandscapeWithTheContactUnderTheBall) {
+  const std::string mini = " --sensor " NORM2TEX_SOURCE_DIR "/config/gelsight_mini.yaml --no-noise";
+  const CliRun run = render("--mesh sphere:4 --pose \"0.003 -0.002 0.004 0 0 0\" --press-mm 1" +
+                            mini + " -o " + path("mini.png") + " --mask-out " + path("mask.png") +
+                            " --markers-out " + path("markers.csv"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const CliRun rest =
+      render("--mesh sphere:4 --pose \"0 0 0.01 0 0 0\"" + mini + " -o " + path("rest.png"));
+  ASSERT_EQ(rest.exit_code, 0) << rest.output;
+  const cv::Mat3b frame = cv::imread(path("mini.png")), background = cv::imread(path("rest.png"));
+  const cv::Mat1b mask = cv::imread(path("mask.png"), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(frame.size(), cv::Size(320, 240));
+  ASSERT_EQ(background.size(), cv::Size(320, 240));
+  ASSERT_EQ(mask.size(), cv::Size(320, 240));
+  const norm2tex::SensorModel mini_model =
+      norm2tex::loadSensorModel(NORM2TEX_SOURCE_DIR "/config/gelsight_mini.yaml");
+  const cv::Moments m = cv::moments(mask, true);
+  ASSERT_GT(m.m00, 500.0);
+  EXPECT_NEAR(m.m10 / m.m00, 159.5 + 3.0 / mini_model.mm_per_pixel, 1.5) << "x = +3 mm: right";
+  EXPECT_NEAR(m.m01 / m.m00, 119.5 - 2.0 / mini_model.mm_per_pixel, 1.5) << "y = -2 mm: up";
+  // The press shows inside the contact, and nowhere far from it.
+  cv::Mat diff;
+  cv::absdiff(frame, background, diff);
+  cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(cv::mean(diff, mask)[0], 5.0);
+  cv::Mat1b far;
+  cv::dilate(mask, far, cv::Mat(), {-1, -1}, 25);
+  cv::bitwise_not(far, far);
+  EXPECT_EQ(cv::countNonZero(diff & far), 0);
+  std::ifstream csv(path("markers.csv"));
+  std::string line;
+  int markers = -1;  // the header
+  while (std::getline(csv, line)) ++markers;
+  EXPECT_EQ(markers, 7 * 9) << "the Mini's grid, not the built-in 9 x 7";
+}
+
 TEST_F(RenderCli, BadInputIsAOneLineErrorOrUsage) {
   const CliRun missing =
       render("--mesh " + path("nope.obj") + " --pose \"0 0 0 0 0 0\" -o " + path("x.png"));

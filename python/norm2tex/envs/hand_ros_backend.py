@@ -140,14 +140,14 @@ class HandRosBackend(RosClient):
         self._take(self._call("step", request))
 
     def images(self):
-        """{sensor: (320, 240, 3) uint8 bgr8}: every sensor's image of the current frame."""
+        """{sensor: (rows, cols, 3) uint8 bgr8}: every sensor's image of the current frame."""
         if self._stamp is None:
             raise self.error("no frame yet; call reset() first")
         msgs = self._wait_for(self._images, self._stamp, "images")
         return {name: bgr8(m, t) for name, m, t in zip(self.sensor_names, msgs, self._images)}
 
     def background(self, sensor):
-        """(320, 240, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""
+        """(rows, cols, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""
         if sensor not in self._backgrounds:
             if sensor not in self.sensor_names:
                 raise KeyError("sensor %r; the hand's: %s" % (sensor, ", ".join(self.sensor_names)))

@@ -199,12 +199,12 @@ class RosBackend(RosClient):
         self.step([mode], [value], frames)
 
     def images(self, finger):
-        """(1, 320, 240, 3) uint8 bgr8: the sensor's image of the current frame."""
+        """(1, rows, cols, 3) uint8 bgr8: the sensor's image of the current frame."""
         self._check_finger(finger)
         return bgr8(self._frame_msg(finger, "image_raw"), "/digit_%s/image_raw" % finger)[None]
 
     def depths(self, finger):
-        """(1, 320, 240) float32 gel deformation [m] of the current frame (needs depth=True)."""
+        """(1, rows, cols) float32 gel deformation [m] of the current frame (needs depth=True)."""
         self._check_finger(finger)
         if not self._depth:
             raise self.error("depths need RosBackend(depth=True) (the renderers publish depth "
@@ -216,7 +216,7 @@ class RosBackend(RosClient):
         return depth.reshape(1, msg.height, msg.width)
 
     def background(self, finger):
-        """(320, 240, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""
+        """(rows, cols, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""
         self._check_finger(finger)
         if finger not in self._backgrounds:
             topic = self._topic(finger, "background")

@@ -30,7 +30,7 @@ STEP = 0.005
 
 def hold_images(material, condition, variants, episodes, seed, opening=HOLD_OPENING, steps=24,
                 batch=8, threads=0):
-    """(left, right): full-resolution diff_float images (episodes, 240, 320, 3) of both sensors
+    """(left, right): full-resolution diff_float images (episodes, rows, cols, 3) of both sensors
     after a scripted hold at `opening`; episode k has seed `seed + k` and a variant drawn from
     `variants`. Raises RuntimeError when a held cube dropped (the opening is then not a hold)."""
     beta = 0.0 if condition == "textureless" else None
