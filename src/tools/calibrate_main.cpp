@@ -42,7 +42,8 @@ norm2tex::cli::Program makeProgram() {
       "       norm2tex_calibrate --judge SENSOR.yaml --background BG.png ... --presses P.png ...\n"
       "                          --ball-diameter-mm D [--labels labels.csv] [--size WxH]\n"
       "                          [--report REPORT.png] [--json REPORT.json]",
-      "Fits a sensor yaml to your DIGIT from no-contact frames and a few ball presses: the scale\n"
+      "Fits a sensor yaml to your DIGIT (or, with --sensor, another sensor such as\n"
+      "config/gelsight_mini.yaml) from no-contact frames and a few ball presses: the scale\n"
       "(unless --mm-per-pixel), the calibrated shading with its rim shadow, and the noise of\n"
       "your no-contact frames, which become the sensor's background (written beside the yaml as\n"
       "<name>_background.png).");
@@ -53,7 +54,7 @@ norm2tex::cli::Program makeProgram() {
       ("presses",
        po::value<std::vector<std::string>>()->multitoken()->composing()->value_name("P.png ..."),
        "Frames of one ball press each, at different places (at least 4; 10-50 recommended), "
-       "portrait as your driver publishes them.")  //
+       "turned as your driver publishes them (portrait for a DIGIT).")  //
       ("ball-diameter-mm", po::value<double>()->value_name("D"),
        "The pressing ball's diameter, mm.")  //
       ("mm-per-pixel", po::value<double>()->value_name("S"),
@@ -67,7 +68,8 @@ norm2tex::cli::Program makeProgram() {
        "Resample every frame to this size first (e.g. 240x320 for VGA captures of a QVGA "
        "sensor). Default: the frames' own size.")  //
       ("sensor", po::value<std::string>()->value_name("base.yaml"),
-       "The sensor yaml to start from (gel, camera); default: the built-in DIGIT.")  //
+       "The sensor yaml to start from (gel, camera, image orientation); default: the built-in "
+       "DIGIT.")  //
       ("holdout", po::value<double>()->value_name("F"),
        "The share of the presses held out to judge the fit (default 0.3).")  //
       ("scale-presses",
@@ -118,17 +120,29 @@ norm2tex::NamedFrame loadFrame(const std::string& path, const std::optional<cv::
 }
 
 // The sensor to start from, at the frames' size: the built-in DIGIT at QVGA or VGA, or
-// --sensor's model; other sizes keep the gel and scale the pixels.
+// --sensor's model; other sizes keep the gel and scale the pixels. Frames turned the other way
+// than the sensor's would be stretched across the wrong axis: an error.
 norm2tex::SensorModel baseModel(const po::variables_map& args, cv::Size frame_size) {
-  if (frame_size.width > frame_size.height) {
-    throw Error("the first background frame is " + std::to_string(frame_size.width) + " x " +
-                std::to_string(frame_size.height) +
-                " (landscape) but DIGIT frames are portrait (320 rows x 240 columns as the "
-                "driver publishes them); rotate your frames the way your driver does");
-  }
+  const bool given = args.count("sensor") > 0;
   norm2tex::SensorModel model =
-      args.count("sensor") ? norm2tex::loadSensorModel(args["sensor"].as<std::string>())
-                           : norm2tex::makeDigitSensorModel(frame_size == cv::Size(480, 640));
+      given ? norm2tex::loadSensorModel(args["sensor"].as<std::string>())
+            : norm2tex::makeDigitSensorModel(frame_size == cv::Size(480, 640));
+  const auto orientation = [](int width, int height) {
+    return width > height ? "landscape" : "portrait";
+  };
+  if (frame_size.width != frame_size.height && model.cols != model.rows &&
+      (frame_size.width > frame_size.height) != (model.cols > model.rows)) {
+    const std::string sensor =
+        given ? "the sensor's (" + args["sensor"].as<std::string>() + ")" : "a DIGIT's";
+    throw Error("the first background frame is " + std::to_string(frame_size.width) + " x " +
+                std::to_string(frame_size.height) + " (" +
+                orientation(frame_size.width, frame_size.height) + ") but " + sensor +
+                " frames are " + orientation(model.cols, model.rows) + " (" +
+                std::to_string(model.rows) + " rows x " + std::to_string(model.cols) +
+                " columns as its driver publishes them); rotate your frames the way your driver "
+                "does" +
+                (given ? "" : ", or give your sensor's yaml (--sensor config/gelsight_mini.yaml)"));
+  }
   if (model.imageSize() != frame_size) {
     const double factor = static_cast<double>(model.cols) / frame_size.width;
     model.mm_per_pixel *= factor;

@@ -131,6 +131,45 @@ TEST_F(CalibrateCli, JudgeRendersAGivenSensorOnThePressesWithoutFitting) {
   EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
 }
 
+// A landscape sensor: presses rendered by the GelSight Mini profile (320 x 240) calibrate with
+// --sensor config/gelsight_mini.yaml into a yaml of the same size, gel and grid; without its yaml
+// the frames are refused as not a DIGIT's, naming the way out.
+TEST_F(CalibrateCli, AGelSightMiniCalibratesFromLandscapeFramesWithItsYaml) {
+  const std::string mini_yaml = NORM2TEX_SOURCE_DIR "/config/gelsight_mini.yaml";
+  const norm2tex::SensorModel m = norm2tex::loadSensorModel(mini_yaml);
+  ASSERT_EQ(m.imageSize(), cv::Size(320, 240));
+  const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m),
+                                     norm2tex::BackgroundSource::kSynthetic);
+  cv::imwrite(path("mini_bg.png"), shader.shade(cv::Mat1f(m.rows, m.cols, 0.0f), 1));
+  std::string presses;
+  const cv::Point2d centres_mm[] = {{-5, -3}, {4, -3}, {0, 0}, {-3, 3}, {5, 3}, {1, -4}};
+  for (int i = 0; i < 6; ++i) {
+    const norm2tex::PressCircle circle{
+        {centres_mm[i].x / m.mm_per_pixel + 159.5, centres_mm[i].y / m.mm_per_pixel + 119.5},
+        (1.1 + 0.12 * i) / m.mm_per_pixel};
+    cv::Mat1f gel;
+    norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+    const std::string name = path("mini_press" + std::to_string(i) + ".png");
+    cv::imwrite(name, shader.shade(gel, 20 + i));
+    presses += " " + name;
+  }
+  const std::string frames = "--background " + path("mini_bg.png") + " --presses" + presses +
+                             " --ball-diameter-mm 6 --mm-per-pixel 0.0634";
+  const CliRun run = calibrate(frames + " --sensor " + mini_yaml + " -o " + path("my_mini.yaml"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const norm2tex::SensorModel fitted = norm2tex::loadSensorModel(path("my_mini.yaml"));
+  EXPECT_EQ(fitted.imageSize(), cv::Size(320, 240));
+  EXPECT_EQ(fitted.shading.kind, norm2tex::ShadingKind::kCalibrated);
+  EXPECT_DOUBLE_EQ(fitted.gel_pad_width_mm, m.gel_pad_width_mm);
+  EXPECT_TRUE(fitted.markers.enabled);
+  EXPECT_EQ(fitted.markers.cols, 9);
+  EXPECT_EQ(cv::imread(fitted.background_image).size(), cv::Size(320, 240));
+  const CliRun digit = calibrate(frames + " -o " + path("x.yaml"));
+  EXPECT_EQ(digit.exit_code, 1) << digit.output;
+  EXPECT_NE(digit.output.find("landscape"), std::string::npos) << digit.output;
+  EXPECT_NE(digit.output.find("--sensor"), std::string::npos) << digit.output;
+}
+
 // Two frames of the ball moved 8 mm between them measure the scale, which the fit then uses as
 // given; the scale is given once.
 TEST_F(CalibrateCli, TwoPressesAKnownDistanceApartGiveTheScale) {

@@ -7,8 +7,8 @@
 
 namespace norm2tex {
 
-/// Scales of the texture band and of the contact, in pixels at QVGA width (240 columns);
-/// scaled with the frame's width.
+/// Scales of the texture band and of the contact, in pixels at QVGA (240 pixels on the short
+/// side); scaled with the frame's (qvgaScale).
 struct TextureBandOptions {
   /// The band: difference of Gaussians between these sigmas (px). The finest relief a DIGIT
   /// resolves is a few pixels; the press's own shading (indentation, slopes of the pressed face,

@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "norm2tex/calibrate/qvga_scale.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/render/digit_shader_noise.hpp"
 
@@ -18,7 +19,7 @@ struct ResidualStats {
 };
 
 cv::Mat3f highPass(const cv::Mat3f& frame) {
-  const double sigma = 3.0 * frame.cols / 240.0;
+  const double sigma = 3.0 * qvgaScale(frame.size());
   const int radius = static_cast<int>(std::ceil(3.0 * sigma));
   cv::Mat3f blurred;
   cv::GaussianBlur(frame, blurred, cv::Size(2 * radius + 1, 2 * radius + 1), sigma, sigma,

@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "norm2tex/calibrate/qvga_scale.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -55,7 +56,7 @@ PressCircle detectPress(const cv::Mat3f& diff, const std::string& frame_name) {
     for (int c = 0; c < diff.cols; ++c)
       m[c] = std::abs(d[c][0]) + std::abs(d[c][1]) + std::abs(d[c][2]);
   }
-  const double sigma = kBlurSigmaAtQvgaPx * diff.cols / 240.0;
+  const double sigma = kBlurSigmaAtQvgaPx * qvgaScale(diff.size());
   const int radius = static_cast<int>(std::ceil(3.0 * sigma));
   cv::GaussianBlur(magnitude, magnitude, cv::Size(2 * radius + 1, 2 * radius + 1), sigma);
   const double baseline = median(magnitude);

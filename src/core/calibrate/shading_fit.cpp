@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "norm2tex/calibrate/ball_press.hpp"
+#include "norm2tex/calibrate/qvga_scale.hpp"
 #include "norm2tex/common/error.hpp"
 #include "norm2tex/common/simd_dispatch.hpp"
 #include "norm2tex/render/digit_shader_response.hpp"
@@ -248,7 +249,7 @@ class GeometrySearch {
       if (p.circle.radius_px > largest_->circle.radius_px) largest_ = &p;
     }
     largest_radius_px_ = largest_->circle.radius_px;
-    const double qvga = 240.0 / base.cols;  // the searched scales, for this resolution
+    const double qvga = 1.0 / qvgaScale(base.imageSize());  // the searched scales, at this size
     scale_lo_ = kMinSearchedScale * qvga;
     scale_hi_ = kMaxSearchedScale * qvga;
     // Searching the scale renders every press for each candidate: with many presses, search on

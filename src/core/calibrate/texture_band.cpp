@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "norm2tex/calibrate/qvga_scale.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -18,7 +19,7 @@ constexpr int kMinContactQvgaPx = 200;
 constexpr int kMinMeasuredQvgaPx = 300;
 constexpr int kMinNoiseQvgaPx = 1500;
 
-double scaleOf(const cv::Mat& image) { return image.cols / 240.0; }
+double scaleOf(const cv::Mat& image) { return qvgaScale(image.size()); }
 
 cv::Mat1f blurred(const cv::Mat1f& image, double sigma) {
   cv::Mat1f out;

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "norm2tex/calibrate/qvga_scale.hpp"
 #include "norm2tex/common/error.hpp"
 
 namespace norm2tex {
@@ -142,7 +143,7 @@ cv::Mat3b makeTextureMatchReport(const TextureMatchResult& result, const cv::Mat
   }
   const char* titles[4] = {"real", "simulated", "real band x4", "simulated band x4"};
   for (int t = 0; t < 4; ++t) text(report, titles[t], {t * kTile + 4, header - 4}, 0.9);
-  const double half = kCropHalfQvgaPx * background.cols / 240.0;
+  const double half = kCropHalfQvgaPx * qvgaScale(background.size());
   for (int i = 0; i < rows; ++i) {
     const FrameMatch& f = result.frames[i];
     const cv::Mat3b tiles[4] = {
