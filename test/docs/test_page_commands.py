@@ -171,11 +171,22 @@ JUDGE_FILES = dict([("bg2.png", os.path.join(S09, "frame_30.jpg"))] +
 SCALE_FILES = {name: ["norm2tex_render", "--mesh", "sphere:3", "--pose", "%s 0 0.003 0 0 0" % x,
                       "--press-mm", "0.5", "--background", "bg.png", "-o"]
                for name, x in (("here.png", "-0.004"), ("moved.png", "0.004"))}
+# gelsight_mini.md's own Mini's frames (mini_bg.png, mini_press_*.png): a no-contact frame and six
+# presses of a 6 mm ball at different places, rendered by the Mini profile itself (dots and all).
+MINI = ["--sensor", "config/gelsight_mini.yaml"]
+GELSIGHT_MINI_FILES = {"mini_bg.png": ["norm2tex_render", "--mesh", "sphere:3", "--pose",
+                                       "0 0 0.01 0 0 0", "--seed", "1"] + MINI + ["-o"]}
+for _i, (_x, _y) in enumerate([(-5, -3), (4, -3), (0, 0), (-3, 3), (5, 3), (1, -4)]):
+    GELSIGHT_MINI_FILES["mini_press_%d.png" % _i] = [
+        "norm2tex_render", "--mesh", "sphere:3", "--pose",
+        "%g %g 0.003 0 0 0" % (_x * 1e-3, _y * 1e-3), "--press-mm", "0.5",
+        "--seed", str(_i + 2)] + MINI + ["-o"]
 # norm2tex_make_demo_normal_map: the package's normal map of known relief (waves, bumps, ridges).
 DEMO_NORMAL_MAP = ["norm2tex_make_demo_normal_map", "--size", "256", "-o"]
 FILES = {
     "README.md": dict(CALIBRATION_FILES, **{"my_normal.png": DEMO_NORMAL_MAP}),
     "docs/calibration.md": dict(CALIBRATION_FILES, **JUDGE_FILES, **SCALE_FILES),
+    "docs/gelsight_mini.md": GELSIGHT_MINI_FILES,
     # A material yaml of your own: the shipped wood's.
     "docs/materials.md": {"my_wood.yaml": os.path.join(ROOT, "config", "materials", "wood.yaml")},
     "docs/texture.md": {"my_normal.png": DEMO_NORMAL_MAP},
