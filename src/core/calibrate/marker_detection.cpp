@@ -51,7 +51,7 @@ DetectedMarkers detectMarkers(const cv::Mat3b& frame) {
     g.convertTo(grey, CV_32F);
   }
   // The light without the dots: a closing wider than a dot (a dot of up to 1/12 of the frame's
-  // short side; GelSight Mini's are ~8 px at 320 x 240).
+  // short side; GelSight Mini's are 12-16 px across at 320 x 240).
   const int k = std::max(5, std::min(frame.rows, frame.cols) / 12) | 1;
   cv::Mat1f light;
   cv::morphologyEx(grey, light, cv::MORPH_CLOSE,
