@@ -19,6 +19,7 @@
 #include "norm2tex/render/digit_shader.hpp"
 #include "norm2tex/render/gel_model.hpp"
 #include "norm2tex/render/sensor_model.hpp"
+#include "norm2tex/shear/marker_pattern.hpp"
 
 namespace {
 using norm2tex::test::CliRun;
@@ -132,15 +133,28 @@ TEST_F(CalibrateCli, JudgeRendersAGivenSensorOnThePressesWithoutFitting) {
 }
 
 // A landscape sensor: presses rendered by the GelSight Mini profile (320 x 240) calibrate with
-// --sensor config/gelsight_mini.yaml into a yaml of the same size, gel and grid; without its yaml
-// the frames are refused as not a DIGIT's, naming the way out.
+// --sensor config/gelsight_mini.yaml into a yaml of the same size, gel and grid: its dots, drawn
+// into every frame as the renderer draws them, are found, filled in before the fit and measured
+// back (grid, pitch, diameter); without its yaml the frames are refused as not a DIGIT's, naming
+// the way out.
 TEST_F(CalibrateCli, AGelSightMiniCalibratesFromLandscapeFramesWithItsYaml) {
   const std::string mini_yaml = NORM2TEX_SOURCE_DIR "/config/gelsight_mini.yaml";
   const norm2tex::SensorModel m = norm2tex::loadSensorModel(mini_yaml);
   ASSERT_EQ(m.imageSize(), cv::Size(320, 240));
   const norm2tex::DigitShader shader(m, norm2tex::makeSyntheticBackground(m),
                                      norm2tex::BackgroundSource::kSynthetic);
-  cv::imwrite(path("mini_bg.png"), shader.shade(cv::Mat1f(m.rows, m.cols, 0.0f), 1));
+  const norm2tex::MarkerPattern pattern(m);
+  std::vector<norm2tex::Marker> rest;
+  for (const cv::Point2f& p : pattern.restPx()) rest.push_back({p, p, {0, 0}});
+  const auto marked = [&](const cv::Mat3b& frame) {
+    cv::Mat3b copy = frame.clone();
+    pattern.draw(copy, rest);  // a pure press leaves the dots where they are
+    return copy;
+  };
+  const cv::Mat3b bg = shader.shade(cv::Mat1f(m.rows, m.cols, 0.0f), 1);
+  cv::imwrite(path("mini_bg.png"), marked(bg));
+  cv::imwrite(path("plain_bg.png"), bg);
+  std::string plain_presses;
   std::string presses;
   const cv::Point2d centres_mm[] = {{-5, -3}, {4, -3}, {0, 0}, {-3, 3}, {5, 3}, {1, -4}};
   for (int i = 0; i < 6; ++i) {
@@ -150,8 +164,12 @@ TEST_F(CalibrateCli, AGelSightMiniCalibratesFromLandscapeFramesWithItsYaml) {
     cv::Mat1f gel;
     norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
     const std::string name = path("mini_press" + std::to_string(i) + ".png");
-    cv::imwrite(name, shader.shade(gel, 20 + i));
+    const cv::Mat3b press = shader.shade(gel, 20 + i);
+    cv::imwrite(name, marked(press));
     presses += " " + name;
+    const std::string plain = path("plain_press" + std::to_string(i) + ".png");
+    cv::imwrite(plain, press);
+    plain_presses += " " + plain;
   }
   const std::string frames = "--background " + path("mini_bg.png") + " --presses" + presses +
                              " --ball-diameter-mm 6 --mm-per-pixel 0.0634";
@@ -161,8 +179,26 @@ TEST_F(CalibrateCli, AGelSightMiniCalibratesFromLandscapeFramesWithItsYaml) {
   EXPECT_EQ(fitted.imageSize(), cv::Size(320, 240));
   EXPECT_EQ(fitted.shading.kind, norm2tex::ShadingKind::kCalibrated);
   EXPECT_DOUBLE_EQ(fitted.gel_pad_width_mm, m.gel_pad_width_mm);
+  EXPECT_NE(run.output.find("markers: 63 found, a 7 x 9 grid"), std::string::npos) << run.output;
   EXPECT_TRUE(fitted.markers.enabled);
+  EXPECT_EQ(fitted.markers.rows, 7);
   EXPECT_EQ(fitted.markers.cols, 9);
+  EXPECT_NEAR(fitted.markers.pitch_mm, m.markers.pitch_mm, 0.03 * m.markers.pitch_mm);
+  EXPECT_NEAR(fitted.markers.dot_diameter_mm, m.markers.dot_diameter_mm,
+              0.1 * m.markers.dot_diameter_mm);
+  // The held-out presses are explained as well as the same presses without dots.
+  const auto heldOutVariance = [](const std::string& output) {
+    const size_t at = output.find("    variance explained ");
+    return at == std::string::npos ? -1.0 : std::stod(output.substr(at + 23));
+  };
+  const CliRun plain = calibrate("--background " + path("plain_bg.png") + " --presses" +
+                                 plain_presses + " --ball-diameter-mm 6 --mm-per-pixel 0.0634" +
+                                 " --sensor " + mini_yaml + " -o " + path("plain_mini.yaml"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_EQ(plain.output.find("markers:"), std::string::npos) << plain.output;
+  EXPECT_GT(heldOutVariance(plain.output), 0.5) << plain.output;
+  EXPECT_NEAR(heldOutVariance(run.output), heldOutVariance(plain.output), 0.03)
+      << run.output << plain.output;
   EXPECT_EQ(cv::imread(fitted.background_image).size(), cv::Size(320, 240));
   const CliRun digit = calibrate(frames + " -o " + path("x.yaml"));
   EXPECT_EQ(digit.exit_code, 1) << digit.output;

@@ -34,6 +34,27 @@ DetectedMarkers detectMarkers(const cv::Mat3b& frame);
 /// shading can be fitted on. `mask` empty: the frame unchanged.
 cv::Mat3b withoutMarkers(const cv::Mat3b& frame, const cv::Mat1b& mask, double sigma_px);
 
+/// Takes a marker gel's dots out of its frames: the light each dot lets through, measured on the
+/// background (the background over its own fill, withoutMarkers, per channel), divides every
+/// frame where it lets through at least kMarkerDivisible, so the shading under a dot is recovered
+/// rather than guessed; the dots' dark cores, where dividing would amplify noise, are filled from
+/// around them. Exact for dots that stay put (a pure press moves none); a dot a press moves
+/// leaves an edge of a pixel or two.
+class MarkerRemoval {
+ public:
+  MarkerRemoval(const cv::Mat3b& background, const DetectedMarkers& markers);
+  cv::Mat3b apply(const cv::Mat3b& frame) const;
+
+ private:
+  cv::Mat1b mask_;          // the dots
+  cv::Mat3f transmission_;  // per channel, 1 outside the dots
+  cv::Mat1b core_;          // where the transmission is too low to divide by
+  double sigma_px_ = 1.5;
+};
+
+/// The least transmission a frame is divided by (a dot's core is darker: filled instead).
+constexpr double kMarkerDivisible = 0.3;
+
 /// Darker than this fraction of the surrounding light counts as a dot.
 constexpr double kMarkerDarkness = 0.2;
 

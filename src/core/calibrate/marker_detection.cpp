@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
@@ -147,6 +148,37 @@ cv::Mat3b withoutMarkers(const cv::Mat3b& frame, const cv::Mat1b& mask, double s
     }
   }
   return out;
+}
+
+MarkerRemoval::MarkerRemoval(const cv::Mat3b& background, const DetectedMarkers& markers)
+    : mask_(markers.mask), sigma_px_(std::max(1.5, 0.5 * markers.diameter_px)) {
+  transmission_ = cv::Mat3f(background.size(), cv::Vec3f(1, 1, 1));
+  core_ = cv::Mat1b::zeros(background.size());
+  if (mask_.empty()) return;
+  const cv::Mat3b filled = withoutMarkers(background, mask_, sigma_px_);
+  for (int r = 0; r < background.rows; ++r) {
+    for (int c = 0; c < background.cols; ++c) {
+      if (!mask_(r, c)) continue;
+      cv::Vec3f& t = transmission_(r, c);
+      for (int k = 0; k < 3; ++k) {
+        t[k] = std::min(1.0f, background(r, c)[k] / std::max(1.0f, float(filled(r, c)[k])));
+        if (t[k] < kMarkerDivisible) core_(r, c) = 255;
+      }
+    }
+  }
+}
+
+cv::Mat3b MarkerRemoval::apply(const cv::Mat3b& frame) const {
+  if (mask_.empty()) return frame.clone();
+  cv::Mat3b out = frame.clone();
+  for (int r = 0; r < frame.rows; ++r) {
+    for (int c = 0; c < frame.cols; ++c) {
+      if (!mask_(r, c) || core_(r, c)) continue;
+      const cv::Vec3f& t = transmission_(r, c);
+      for (int k = 0; k < 3; ++k) out(r, c)[k] = cv::saturate_cast<std::uint8_t>(frame(r, c)[k] / t[k]);
+    }
+  }
+  return withoutMarkers(out, core_, sigma_px_);
 }
 
 }  // namespace norm2tex

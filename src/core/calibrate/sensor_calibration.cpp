@@ -213,15 +213,11 @@ CalibrationInput markerFreeInput(const CalibrationInput& input, DetectedMarkers&
   meanBackground(input.backgrounds).convertTo(background, CV_8U);
   markers = detectMarkers(background);
   if (!markers.found()) return input;
-  // The dots are filled from a ring about their own radius wide around them.
-  const double sigma = std::max(1.5, 0.5 * markers.diameter_px);
+  // Divided by the light each dot lets through, measured on the background; cores filled in.
+  const MarkerRemoval removal(background, markers);
   CalibrationInput clean = input;
-  for (NamedFrame& frame : clean.backgrounds) {
-    frame.image = withoutMarkers(frame.image, markers.mask, sigma);
-  }
-  for (NamedFrame& frame : clean.presses) {
-    frame.image = withoutMarkers(frame.image, markers.mask, sigma);
-  }
+  for (NamedFrame& frame : clean.backgrounds) frame.image = removal.apply(frame.image);
+  for (NamedFrame& frame : clean.presses) frame.image = removal.apply(frame.image);
   return clean;
 }
 
