@@ -11,7 +11,7 @@ namespace norm2tex {
 namespace {
 
 // At most this many steps of d*'s search (Newton's converge in a handful).
-constexpr int kBisections = 40;
+constexpr int kMaxStickDepthSteps = 40;
 
 struct ContactCell {
   int index;              // into the grid, row-major
@@ -42,7 +42,7 @@ void requireLoad(double normal_force_n, const ShearLoad& load, double friction) 
 double stickDepth(const std::vector<ContactCell>& cells, double target, double deepest) {
   double low = 0.0, high = deepest;
   double ds = 0.0;
-  for (int i = 0; i < kBisections; ++i) {
+  for (int i = 0; i < kMaxStickDepthSteps; ++i) {
     double sum = 0.0, slope = 0.0;
     for (const ContactCell& c : cells) {
       const double rest = c.depth - ds;
