@@ -40,7 +40,9 @@ class ExportedDataset(torch.utils.data.Dataset):
 
     root: the export directory (with labels.csv).
     image: "diff" (image - background, float grey levels, 0 where nothing touches),
-        "raw" (the sensor image, 0..255) or "depth" (gel indentation in millimetres).
+        "raw" (the sensor image, 0..255), "depth" (gel indentation in millimetres) or "shear"
+        (the gel surface's lateral displacement at each pixel, (2, rows, cols), millimetres, gel
+        frame x and y; recorded with the recorder's ~record_shear).
     materials, variants, sensors: keep only these (None: all). Holding variants out
         is how the paper tests generalisation to unseen textures.
     transform: applied to the image tensor.
@@ -49,8 +51,8 @@ class ExportedDataset(torch.utils.data.Dataset):
 
     def __init__(self, root, image="diff", materials=None, variants=None, sensors=None,
                  transform=None, return_labels=False):
-        if image not in ("diff", "raw", "depth"):
-            raise ValueError(f"image must be diff, raw or depth, not {image!r}")
+        if image not in ("diff", "raw", "depth", "shear"):
+            raise ValueError(f"image must be diff, raw, depth or shear, not {image!r}")
         labels = os.path.join(root, "labels.csv")
         if not os.path.isfile(labels):
             raise FileNotFoundError(f"{labels} not found: is {root!r} a norm2tex_export directory?")
@@ -68,6 +70,9 @@ class ExportedDataset(torch.utils.data.Dataset):
                      and (sensors is None or r["sensor"] in sensors)]
         if image == "depth" and any(not r["depth"] for r in self.rows):
             raise ValueError("image='depth' but some frames were exported without depth")
+        if image == "shear" and any(not r.get("shear") for r in self.rows):
+            raise ValueError("image='shear' but some frames were exported without the shear field "
+                             "(record with dataset_recorder's ~record_shear)")
         self.classes = sorted({r["material"] for r in rows})
         self.class_to_idx = {c: i for i, c in enumerate(self.classes)}
 
@@ -84,6 +89,9 @@ class ExportedDataset(torch.utils.data.Dataset):
             else:
                 array = _read_png(path).astype(np.float32) / 1000.0  # micrometres -> mm
             tensor = torch.from_numpy(array)[None]
+        elif self.image == "shear":
+            array = np.load(path) * np.float32(1000.0)  # (rows, cols, 2) metres -> mm
+            tensor = torch.from_numpy(np.ascontiguousarray(array.transpose(2, 0, 1)))
         else:
             array = _read_png(path).astype(np.float32)
             if self.image == "diff":

@@ -263,7 +263,8 @@ void bindHand(py::module& m) {
              return contactDict(s.contact(sensorFrom(s, sensor)));
            }, py::arg("sensor"),
            "What a gel feels: in_contact, normal_force_n (N), shear_force_n (N, gel frame), "
-           "penetration_m, too_deep, object_in_gel (4x4).")
+           "pressure_centre_m (gel x, y, m), twist_moment_nm (N m, about the gel's +z "
+           "through that centre), penetration_m, too_deep, object_in_gel (4x4).")
       .def("gel_in_world", [](const HandSim& s, const py::object& sensor) {
              return poseToNumpy(s.gelInWorld(sensorFrom(s, sensor)));
            }, py::arg("sensor"), "the sensor's gel frame in the world (4x4, m)")

@@ -181,6 +181,9 @@ void bindRender(py::module& m) {
           "markers_enabled", [](const SensorModel& s) { return s.markers.enabled; },
           [](SensorModel& s, bool on) { s.markers.enabled = on; },
           "whether the gel carries the printed marker grid (the yaml's markers section)")
+      .def_property_readonly(
+          "marker_grid", [](const SensorModel& s) { return py::make_tuple(s.markers.rows, s.markers.cols); },
+          "(rows, cols) of the marker grid (the yaml's markers section, drawn when enabled)")
       .def_property(
           "shear_modulus_mpa", [](const SensorModel& s) { return s.shear.shear_modulus_mpa; },
           [](SensorModel& s, double g) { s.shear.shear_modulus_mpa = g; },

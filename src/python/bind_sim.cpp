@@ -171,7 +171,8 @@ void bindSim(py::module& m) {
           },
           py::arg("finger"),
           "What the gel of 'left' or 'right' feels: in_contact, normal_force_n (N), "
-          "shear_force_n (N, gel frame), penetration_m, too_deep, object_in_gel (4x4).")
+          "shear_force_n (N, gel frame), pressure_centre_m (gel x, y, m), twist_moment_nm (N m, "
+          "about the gel's +z through that centre), penetration_m, too_deep, object_in_gel (4x4).")
       .def("object_in_world", [](const GripperSim& s) { return poseToNumpy(s.objectInWorld()); })
       .def("gel_in_world", [](const GripperSim& s, const std::string& finger) {
              return poseToNumpy(s.gelInWorld(fingerFrom(finger)));

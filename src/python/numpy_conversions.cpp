@@ -119,6 +119,8 @@ py::dict contactDict(const GelContactState& c) {
   out["in_contact"] = c.in_contact;
   out["normal_force_n"] = c.normal_force_n;
   out["shear_force_n"] = Eigen::Vector3d(c.shear_force_n);
+  out["pressure_centre_m"] = Eigen::Vector2d(c.pressure_centre_m);
+  out["twist_moment_nm"] = c.twist_moment_nm;
   out["penetration_m"] = c.penetration_m;
   out["too_deep"] = c.too_deep;
   out["object_in_gel"] = poseToNumpy(c.object_in_gel);

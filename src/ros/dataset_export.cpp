@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "norm2tex/common/error.hpp"
+#include "norm2tex/common/npy_file.hpp"
 #include "tactile_bag_reader.hpp"
 
 namespace norm2tex {
@@ -89,7 +90,7 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
   // Columns added later go at the end, so readers by position keep working.
   labels << "raw,diff,depth,material,variant,sensor,stamp,episode,object,beta,seed,scenario,"
             "shard,press,press_depth,in_contact,normal_force,max_indentation,contact_area,bag,"
-            "twist_moment,slip_fraction,markers\n";
+            "twist_moment,slip_fraction,markers,shear\n";
   ExportSummary summary;
   std::set<std::string> names;
   reader.forEachSample([&](const TactileSample& s) {
@@ -142,6 +143,13 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
       writeMarkers(out / markers, s.markers);
       ++summary.frames_with_markers;
     }
+    std::string shear;
+    if (!s.shear_m.empty()) {
+      shear = "shear/" + file + ".npy";
+      fs::create_directories((out / shear).parent_path());
+      writeNpy((out / shear).string(), s.shear_m);
+      ++summary.frames_with_shear;
+    }
     const TactileContact& c = s.contact;
     labels << raw << "," << diff << "," << depth << "," << csv(material) << "," << e.variant << ","
            << s.sensor << "," << s.stamp.toNSec() << "," << e.episode << "," << csv(e.object) << ","
@@ -151,7 +159,7 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
            << (s.has_contact ? c.max_indentation : NAN) << ","
            << (s.has_contact ? c.contact_area : NAN) << "," << csv(fs::path(s.bag).filename().string())
            << "," << (s.has_contact ? c.twist_moment : NAN) << ","
-           << (s.has_contact ? c.slip_fraction : NAN) << "," << markers << "\n";
+           << (s.has_contact ? c.slip_fraction : NAN) << "," << markers << "," << shear << "\n";
     if (!labels) throw Error("writing labels.csv failed (disk full?)");
     ++summary.frames;
     ++summary.frames_per_material[material];
@@ -178,6 +186,10 @@ ExportSummary exportDataset(const std::vector<std::string>& bags, const ExportOp
   if (summary.frames_with_markers > 0) {
     yaml << "  markers: CSV per frame, a row per marker: grid row and column, rest and current "
             "position (pixels, x = column, y = row), displacement (mm, gel frame)\n";
+  }
+  if (summary.frames_with_shear > 0) {
+    yaml << "  shear: NumPy .npy per frame, float32 (rows, cols, 2): the gel surface's lateral "
+            "displacement at each pixel, metres, gel frame x, y\n";
   }
   yaml << "bags:\n";
   for (const std::string& bag : bags) yaml << "  - '" << bag << "'\n";

@@ -21,6 +21,7 @@ struct ExportOptions {
 struct ExportSummary {
   std::uint64_t frames = 0;
   std::uint64_t frames_with_markers = 0;
+  std::uint64_t frames_with_shear = 0;  ///< recorded with the recorder's ~record_shear
   std::map<std::string, std::uint64_t> frames_per_material;
   /// What the bags held that could not be read (TactileBagReader::warnings).
   std::vector<std::string> warnings;

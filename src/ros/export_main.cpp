@@ -23,7 +23,8 @@ norm2tex::cli::Program makeProgram() {
       "Exports dataset_recorder bags for training: DIR/raw/<material>/*.png,\n"
       "DIR/diff/<material>/*.png (image - background + 128), DIR/depth/<material>/*.png\n"
       "(uint16 micrometres; --depth tiff: float32 metres), DIR/markers/<material>/*.csv (sensors\n"
-      "with markers), DIR/labels.csv and DIR/export.yaml.\n"
+      "with markers), DIR/shear/<material>/*.npy (recorded with ~record_shear), DIR/labels.csv\n"
+      "and DIR/export.yaml.\n"
       "The bags of one recording (split parts, shards) are read in the order given.");
   program.positional("BAG", -1, po::value<std::vector<std::string>>());
   program.add()  //

@@ -417,6 +417,11 @@ HandState HandSimRos::state() const {
     tf2::toMsg(contact.shear_force_n, shear);
     out.shear_force.push_back(shear);
     out.penetration.push_back(contact.penetration_m);
+    geometry_msgs::Point centre;
+    centre.x = contact.pressure_centre_m.x();
+    centre.y = contact.pressure_centre_m.y();
+    out.pressure_centre.push_back(centre);
+    out.twist_moment.push_back(contact.twist_moment_nm);
     out.too_deep.push_back(contact.too_deep);
     out.object_in_gel.push_back(tf2::toMsg(contact.object_in_gel));
   }

@@ -71,6 +71,34 @@ def test_hand_sim_bindings_command_joints_and_report_contacts():
     np.testing.assert_allclose(sim.object_in_world()[:3, 3], [0.0, 0.5, 0.015], atol=1e-9)
 
 
+def test_contacts_carry_the_twist_that_holds_a_cube_gripped_off_its_centre():
+    # The built-in parallel gripper holds the 30 mm cube 4 mm off its centre along world x: its
+    # weight m g dx turns it about the grip axis (world y), and only the gels' twist holds it
+    # (the core's GelTwistMoment test, here through the bindings' contact dicts).
+    scene = norm2tex.SceneConfig.load(norm2tex.scene_config("cube"))
+    config = norm2tex.HandSimConfig(norm2tex.config_path("hands", "parallel_gripper.yaml"), scene)
+    dx = 0.004
+    config.object_pose = ([dx, 0.0, 0.2], [0.0, 0.0, 0.0, 1.0])
+    sim = norm2tex.HandSim(config)
+    sim.reset_object(config.object_pose, False)
+    sim.set_opening(0.0)
+    sim.step(1500)
+    sim.set_object_gravity(True)
+    sim.step(1000)
+    weight_moment = scene.object.mass_kg * scene.physics.gravity_m_s2 * dx
+    about_grip_axis = []
+    for name in sim.sensor_names:
+        c = sim.contact(name)
+        assert c["in_contact"], name
+        assert c["pressure_centre_m"].shape == (2,)
+        # The pads are smaller than the cube's faces: the gels press about their own centres.
+        assert np.abs(c["pressure_centre_m"]).max() < 2e-3, (name, c["pressure_centre_m"])
+        about_grip_axis.append(c["twist_moment_nm"] * sim.gel_in_world(name)[1, 2])
+    for twist in about_grip_axis:
+        assert twist == pytest.approx(0.5 * weight_moment, rel=0.2)
+    assert sum(about_grip_axis) == pytest.approx(weight_moment, rel=0.05)
+
+
 def test_tactile_hand_renders_one_image_per_digit_of_the_allegro():
     config = norm2tex.HandSimConfig(ALLEGRO)
     config.object.mesh = "sphere:10"

@@ -7,6 +7,7 @@ Starts its own master on a free port (scripts/free_port). Run (with the workspac
     /usr/bin/python3 -m pytest -q test/python/test_hand_ros_backend.py
 """
 import os
+import tempfile
 
 import numpy as np
 import pytest
@@ -33,11 +34,24 @@ POSE_TOLERANCE = 1e-12
 
 
 @pytest.fixture(scope="module")
-def ros_system():
+def sensor_yaml():
+    """The default DIGIT with its marker grid drawn: both sides render the gels' lateral motion
+    from the physics' tangential forces and twists."""
+    import norm2tex
+
+    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    model.markers_enabled = True
+    path = os.path.join(tempfile.mkdtemp(prefix="norm2tex_hand_ros_backend_sensor_"), "digit.yaml")
+    model.save(path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def ros_system(sensor_yaml):
     """hand_sim.launch mode:=synchronous with the WSG-50 on a master of its own; this process's
     rospy on it."""
     with ros_launch.system(["norm2tex", "hand_sim.launch", "mode:=synchronous",
-                            "hand:=" + WSG_TOP, "noise_seed:=-1"],
+                            "hand:=" + WSG_TOP, "noise_seed:=-1", "sensor:=" + sensor_yaml],
                            "norm2tex_hand_ros_backend_test_") as system:
         yield system
 
@@ -53,9 +67,10 @@ def wsg(**kwargs):
 
 
 @pytest.fixture(scope="module")
-def envs(ros_system):
-    over_ros = ros_launch.joined(lambda: wsg(backend="ros"), ros_system[1])
-    in_process = wsg()
+def envs(ros_system, sensor_yaml):
+    over_ros = ros_launch.joined(lambda: wsg(backend="ros", sensor=sensor_yaml, markers=True),
+                                 ros_system[1])
+    in_process = wsg(sensor=sensor_yaml, markers=True)
     yield over_ros, in_process
     over_ros.close()
     in_process.close()
@@ -83,6 +98,7 @@ def test_same_episodes_over_both_backends(envs):
                               in_process.backend.background(name))
 
     differing, worst, frames, pressed = [], 0, 0, 0
+    moved = []  # the largest marker displacement of each frame, mm
 
     def compare(a, b, info_a, info_b, where):
         nonlocal worst, frames, pressed
@@ -97,9 +113,12 @@ def test_same_episodes_over_both_backends(envs):
         for name in over_ros.sensor_names:
             x, y = info_a["contacts"][name], info_b["contacts"][name]
             assert x.keys() == y.keys()
-            for key in ("in_contact", "normal_force_n", "penetration_m", "too_deep"):
+            for key in ("in_contact", "normal_force_n", "penetration_m", "too_deep",
+                        "twist_moment_nm"):
                 assert x[key] == y[key], (where, name, key, x[key], y[key])
             np.testing.assert_array_equal(x["shear_force_n"], y["shear_force_n"], err_msg=where)
+            np.testing.assert_array_equal(x["pressure_centre_m"], y["pressure_centre_m"],
+                                          err_msg=where)
             np.testing.assert_allclose(x["object_in_gel"], y["object_in_gel"], rtol=0,
                                        atol=POSE_TOLERANCE, err_msg=where)
             assert a[name].shape == b[name].shape == (320, 240, 3), where
@@ -107,6 +126,10 @@ def test_same_episodes_over_both_backends(envs):
             differing.append(float(np.mean(d > 0)))
             worst = max(worst, int(d.max()))
             frames += 1
+            markers = a[name + "_markers"]
+            assert markers.shape == (63, 2) and markers.dtype == np.float32, where
+            np.testing.assert_array_equal(markers, b[name + "_markers"], err_msg=where)
+            moved.append(float(np.abs(markers).max()))
         pressed += all(info_a["contacts"][n]["in_contact"] for n in over_ros.sensor_names)
 
     # The cube where it lies, then turned by 0.3 rad and shifted (a pose through a quaternion).
@@ -126,6 +149,8 @@ def test_same_episodes_over_both_backends(envs):
           "%.6f mean %.6f, max difference %d grey levels"
           % (frames, max(differing), float(np.mean(differing)), worst))
     assert pressed >= 20, "the actions should hold the cube with both gels (a state worth comparing)"
+    # Closing on the cube drags the gels' surfaces: the markers move (else equality says little).
+    assert max(moved) > 0.01, max(moved)
     assert max(differing) <= MAX_DIFFERING_PIXEL_FRACTION
     assert worst <= MAX_PIXEL_DIFFERENCE
 
@@ -162,6 +187,24 @@ def test_an_environment_unlike_the_running_system_is_refused(envs):
         wsg(backend="ros", noise=True)
     with pytest.raises(ValueError, match="object sphere:10 .*launch with mesh:=sphere:10"):
         wsg(backend="ros", object="sphere:10")
+
+
+def test_markers_of_a_sensor_without_a_grid_are_refused(envs):
+    """A renderer whose ~sensor has no marker grid publishes no markers: asking for them names
+    the sensor and what to launch instead (the backend reads each renderer's ~sensor, here
+    pointed at the plain DIGIT for the time of the test)."""
+    import norm2tex
+    import rospy
+    from norm2tex.envs.hand_ros_backend import HandRosBackend
+
+    param = "/digit_right_renderer/sensor"
+    launched = rospy.get_param(param)
+    rospy.set_param(param, norm2tex.config_path("digit.yaml"))
+    try:
+        with pytest.raises(norm2tex.Error, match="digit_right .*has no marker grid.*gelsight_mini"):
+            HandRosBackend(service_timeout_s=40.0, markers=True)
+    finally:
+        rospy.set_param(param, launched)
 
 
 def test_no_system_is_a_clear_error(ros_system):

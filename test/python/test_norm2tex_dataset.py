@@ -54,6 +54,34 @@ class LabelParsingTest(unittest.TestCase):
 
 
 @unittest.skipIf(torch is None, TORCH_MISSING if torch is None else "")
+class ShearFieldTest(unittest.TestCase):
+    def test_the_shear_field_loads_in_millimetres_channels_first(self):
+        # As norm2tex_export writes it (the tactile_markers rostest checks its bytes against
+        # numpy.save's layout): (rows, cols, 2) float32 metres per frame, named in labels.csv.
+        root = tempfile.mkdtemp(prefix="norm2tex_shear_test_")
+        try:
+            field = np.zeros((4, 3, 2), np.float32)
+            field[1, 2] = (2.5e-4, -1e-4)
+            os.makedirs(os.path.join(root, "shear", "wood"))
+            np.save(os.path.join(root, "shear", "wood", "a.npy"), field)
+            with open(os.path.join(root, "labels.csv"), "w") as f:
+                f.write("raw,diff,depth,material,variant,sensor,stamp,markers,shear\n")
+                f.write("a.png,b.png,,wood,0,digit_left,1,,shear/wood/a.npy\n")
+            tensor, label = ExportedDataset(root, image="shear")[0]
+            self.assertEqual(tuple(tensor.shape), (2, 4, 3))
+            self.assertEqual(tensor.dtype, torch.float32)
+            self.assertAlmostEqual(float(tensor[0, 1, 2]), 0.25, places=6)
+            self.assertAlmostEqual(float(tensor[1, 1, 2]), -0.1, places=6)
+            self.assertEqual(float(tensor.abs().sum()), float(tensor[:, 1, 2].abs().sum()))
+            with open(os.path.join(root, "labels.csv"), "a") as f:
+                f.write("a.png,b.png,,wood,0,digit_left,2,,\n")
+            with self.assertRaisesRegex(ValueError, "without the shear field.*record_shear"):
+                ExportedDataset(root, image="shear")
+        finally:
+            shutil.rmtree(root, ignore_errors=True)
+
+
+@unittest.skipIf(torch is None, TORCH_MISSING if torch is None else "")
 class DatasetTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -151,7 +179,7 @@ class DatasetTest(unittest.TestCase):
             BagDataset([not_a_bag])
         with self.assertRaisesRegex(FileNotFoundError, "labels.csv"):
             ExportedDataset(self.dir)
-        with self.assertRaisesRegex(ValueError, "diff, raw or depth"):
+        with self.assertRaisesRegex(ValueError, "diff, raw, depth or shear"):
             ExportedDataset(self.export, image="rgb")
 
 

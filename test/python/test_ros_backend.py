@@ -27,12 +27,14 @@ MAX_PIXEL_DIFFERENCE = 0
 
 @pytest.fixture(scope="module")
 def sensor_yaml():
-    """The default DIGIT with the texture's conformity on: both sides must then pass the gels'
-    normal forces to their renderers (contact_sim in SimFrame.normal_force) to agree."""
+    """The default DIGIT with the texture's conformity on and its marker grid drawn: both sides
+    must then pass the gels' normal forces, tangential forces and twists to their renderers
+    (contact_sim in SimFrame) to agree."""
     import norm2tex
 
     model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
     model.conformity_enabled = True
+    model.markers_enabled = True
     path = os.path.join(tempfile.mkdtemp(prefix="norm2tex_ros_backend_sensor_"), "digit.yaml")
     model.save(path)
     return path
@@ -53,7 +55,8 @@ def backends(ros_system, sensor_yaml):
     from norm2tex.envs.inprocess_backend import InProcessBackend
     from norm2tex.envs.ros_backend import RosBackend
 
-    ros = ros_launch.joined(lambda: RosBackend(service_timeout_s=40.0, depth=True), ros_system[1])
+    ros = ros_launch.joined(lambda: RosBackend(service_timeout_s=40.0, depth=True, markers=True),
+                            ros_system[1])
     inproc = InProcessBackend(seed=LAUNCH_SEED, noise_seed=None, noise_per_episode=False,
                               sensor=sensor_yaml)
     yield ros, inproc
@@ -84,8 +87,10 @@ def test_same_frames_as_in_process(backends):
     for finger in ("left", "right"):
         assert np.array_equal(ros.background(finger), inproc.background(finger))
 
+    assert ros.marker_count == inproc.marker_count == 9 * 7
     low, high = inproc.height_offset_range
     differing, worst, frames = [], 0, 0
+    moved = []  # the largest marker displacement of each frame, mm
 
     def compare(where):
         nonlocal worst, frames
@@ -103,6 +108,11 @@ def test_same_frames_as_in_process(backends):
             worst = max(worst, int(d.max()))
             np.testing.assert_array_equal(ros.depths(finger), inproc.depths(finger),
                                           err_msg=f"{where} depth {finger}")
+            markers = ros.markers(finger)
+            assert markers.shape == (1, 63, 2) and markers.dtype == np.float32
+            np.testing.assert_array_equal(markers, inproc.markers(finger),
+                                          err_msg=f"{where} markers {finger}")
+            moved.append(float(np.abs(markers).max()))
             frames += 1
         return a
 
@@ -129,6 +139,8 @@ def test_same_frames_as_in_process(backends):
           % (frames, max(differing), float(np.mean(differing)), worst))
     assert dropped_seen, "the script should drop the cube (a state worth comparing)"
     assert pressed_seen >= 20, "the script should hold the cube with both gels"
+    # The held cube's weight drags the gels: the markers move (else their equality says little).
+    assert max(moved) > 0.01, max(moved)
     # The variant did reach the ROS renderers: the same episode start in variant 0 looks different
     # (and again equal in-process).
     seed, offset, _ = episodes[1]
@@ -194,10 +206,11 @@ def test_the_environment_is_the_same_over_both_backends(backends, sensor_yaml):
     """GripperEnv over ROS and in-process: same seeds and actions, the same observations."""
     from norm2tex.envs import GripperEnv
 
-    over_ros = GripperEnv(backend="ros", noise=False, sensor=sensor_yaml,
+    over_ros = GripperEnv(backend="ros", noise=False, sensor=sensor_yaml, markers=True,
                           ros_options={"service_timeout_s": 40.0})
-    in_process = GripperEnv(noise=False, sensor=sensor_yaml)
+    in_process = GripperEnv(noise=False, sensor=sensor_yaml, markers=True)
     assert over_ros.observation_space.keys() == in_process.observation_space.keys()
+    assert over_ros.observation_space["markers_left"].shape == (63, 2)
     actions = np.random.default_rng(1).integers(0, 3, size=25)
     for seed in (1, 2):
         a, info_a = over_ros.reset(seed=seed)

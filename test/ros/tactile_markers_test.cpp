@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
@@ -21,6 +23,7 @@
 #include <opencv2/core.hpp>
 
 #include "dataset_export.hpp"
+#include "norm2tex/common/npy_file.hpp"
 #include "norm2tex/Reset.h"
 #include "norm2tex/Step.h"
 #include "norm2tex/TactileContact.h"
@@ -288,7 +291,9 @@ TEST(SynchronousMarkers, TheRecordersBagsGiveBackTheMarkersAndTheShear) {
   ASSERT_FALSE(bags.empty());
   norm2tex::TactileBagReader reader(bags);
   int compared = 0;
+  std::map<std::pair<std::string, std::uint64_t>, cv::Mat2f> recorded_shear;
   reader.forEachSample([&](const norm2tex::TactileSample& s) {
+    recorded_shear[{s.sensor, s.stamp.toNSec()}] = s.shear_m.clone();
     SCOPED_TRACE(s.sensor + " at " + std::to_string(s.stamp.toSec()));
     ASSERT_TRUE(s.has_markers);
     ASSERT_FALSE(s.shear_m.empty());
@@ -322,9 +327,28 @@ TEST(SynchronousMarkers, TheRecordersBagsGiveBackTheMarkersAndTheShear) {
   std::ifstream labels(out + "/labels.csv");
   std::string header, row;
   ASSERT_TRUE(std::getline(labels, header));
-  EXPECT_NE(header.find(",bag,twist_moment,slip_fraction,markers"), std::string::npos) << header;
+  EXPECT_NE(header.find(",bag,twist_moment,slip_fraction,markers,shear"), std::string::npos)
+      << header;
   ASSERT_TRUE(std::getline(labels, row));
-  const std::string markers_csv = row.substr(row.rfind(',') + 1);
+  std::vector<std::string> cells;
+  for (std::stringstream fields(row); cells.size() < 64;) {
+    std::string cell;
+    if (!std::getline(fields, cell, ',')) break;
+    cells.push_back(cell);
+  }
+  ASSERT_EQ(cells.size(), 24u) << row;  // no quoted field in these rows
+  // The shear field as a NumPy array: its header, then the recorded field's values.
+  const std::string& shear_npy = cells[23];
+  ASSERT_EQ(shear_npy.rfind("shear/", 0), 0u) << row;
+  const cv::Mat2f& field = recorded_shear.at({cells[5], std::stoull(cells[6])});
+  std::ifstream npy(out + "/" + shear_npy, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(npy)), std::istreambuf_iterator<char>());
+  const std::string npy_header = norm2tex::npyHeader(field.rows, field.cols, 2);
+  ASSERT_EQ(bytes.size(), npy_header.size() + field.total() * sizeof(cv::Vec2f));
+  EXPECT_EQ(bytes.substr(0, npy_header.size()), npy_header);
+  EXPECT_EQ(std::memcmp(bytes.data() + npy_header.size(), field.ptr(), field.total() * 8), 0);
+  EXPECT_EQ(summary.frames_with_shear, summary.frames);
+  const std::string markers_csv = cells[22];
   ASSERT_EQ(markers_csv.rfind("markers/", 0), 0u) << row;
   std::ifstream markers(out + "/" + markers_csv);
   std::string line;

@@ -68,7 +68,7 @@ class GripperVectorEnv(spaces.EnvBase):
       markers: also "markers_left"/"markers_right": every marker's displacement on the gel
         (markers, 2) float32, mm (gel frame x, y), carried by the gel's lateral motion under the
         physics' tangential force and twist; needs a sensor with a marker grid (its yaml's
-        markers:) and the in-process backend.
+        markers:; over ROS, the launch's sensor:=).
       frames_per_step: sensor frames per step.
       max_episode_steps: truncation (None: never).
       backend: "inprocess" or "ros" (num_envs 1; ros_options are RosBackend's arguments).
@@ -119,8 +119,6 @@ class GripperVectorEnv(spaces.EnvBase):
         self.with_depth = bool(depth)
         self.with_force = bool(force)
         self.with_markers = bool(markers)
-        if self.with_markers and backend != "inprocess":
-            raise ValueError("markers=True needs backend='inprocess'")
         self.frames_per_step = int(frames_per_step)
         self.max_episode_steps = max_episode_steps
         self.render_mode = render_mode
@@ -148,7 +146,7 @@ class GripperVectorEnv(spaces.EnvBase):
                 raise ValueError("backend 'ros' drives one running gripper: num_envs must be 1")
             from norm2tex.envs.ros_backend import RosBackend
 
-            self.backend = RosBackend(**(ros_options or {}))
+            self.backend = RosBackend(**dict(ros_options or {}, markers=self.with_markers))
             self._check_ros_system(scene, sensor, material, beta_mm, friction)
         else:
             raise ValueError("backend = %r; valid: inprocess, ros" % backend)
@@ -232,7 +230,7 @@ class GripperVectorEnv(spaces.EnvBase):
         if self.with_force:
             entries.append(("force", spaces.Box(0.0, np.inf, shape=(2,), dtype=np.float32)))
         if self.with_markers:
-            count = self.backend.markers("left").shape[1]
+            count = self.backend.marker_count
             if count == 0:
                 raise ValueError("markers=True needs a sensor with a marker grid (its yaml's "
                                  "markers: enabled: true), e.g. config/gelsight_mini.yaml")

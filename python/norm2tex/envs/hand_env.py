@@ -96,8 +96,8 @@ class HandEnv(spaces.EnvBase):
       noise: image noise on (its seed drawn from reset's seed) or off. The default sensor's
         captured background carries the real DIGIT's noise and gets none on top.
       markers: also "<sensor>_markers" for every sensor: its markers' displacement on the gel,
-        (markers, 2) float32 mm (gel frame); needs sensors with a marker grid and the in-process
-        backend.
+        (markers, 2) float32 mm (gel frame); needs sensors with a marker grid (over ROS, the
+        launch's).
       frames_per_step: sensor frames per step.
       max_steps: truncation (None: never).
       backend: "inprocess", or "ros": a running hand_sim.launch mode:=synchronous
@@ -143,8 +143,6 @@ class HandEnv(spaces.EnvBase):
             raise ValueError("reward = %r; valid: None or a callable reward(obs, info)" % (reward,))
         if backend not in ("inprocess", "ros"):
             raise ValueError("backend = %r; valid: inprocess, ros" % (backend,))
-        if markers and backend != "inprocess":
-            raise ValueError("markers=True needs backend='inprocess'")
         self.with_markers = bool(markers)
         self.action_kind = action
         self.frames_per_step = int(frames_per_step)
@@ -161,7 +159,7 @@ class HandEnv(spaces.EnvBase):
         else:
             from norm2tex.envs.hand_ros_backend import HandRosBackend
 
-            self.backend = HandRosBackend(**(ros_options or {}))
+            self.backend = HandRosBackend(**dict(ros_options or {}, markers=bool(markers)))
             self._check_ros_system(hand, object, scale, scene, sensor, material, variant,
                                    beta_mm, friction)
         b = self.backend
@@ -201,12 +199,13 @@ class HandEnv(spaces.EnvBase):
                                                (self.joint_upper + 1e-6).astype(np.float32),
                                                shape=(n,), dtype=np.float32)))
         if self.with_markers:
-            for name, moved in b.markers().items():
-                if moved.shape[0] == 0:
+            for name in self.sensor_names:
+                count = b.marker_counts[name]
+                if count == 0:
                     b.close()
                     raise ValueError("markers=True: sensor %s has no marker grid (its yaml's "
                                      "markers: enabled: true)" % name)
-                entries.append((name + "_markers", spaces.Box(-np.inf, np.inf, shape=moved.shape,
+                entries.append((name + "_markers", spaces.Box(-np.inf, np.inf, shape=(count, 2),
                                                               dtype=np.float32)))
         self.observation_space = spaces.Dict(dict(entries))
         self._rng = np.random.default_rng()

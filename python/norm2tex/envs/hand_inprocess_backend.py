@@ -18,6 +18,8 @@ class HandInProcessBackend:
       reset(object_pose)              # (xyz, quaternion xyzw) of the object in the world
       step(targets, frames=1)         # a target per actuated joint, then `frames` frames
       images() -> {sensor: (rows, cols, 3) uint8 bgr8} of the current frame
+      marker_counts                   ({sensor: its markers}; 0: its gel has no marker grid)
+      markers() -> {sensor: (markers, 2) float32 mm}   (HandRosBackend: with markers=True)
       background(sensor) -> (rows, cols, 3) uint8 (no contact, no noise)
       state() -> dict(joint_positions, joint_targets: (n,) float64, object_in_world: 4x4,
                       contacts: {sensor: HandSim.contact's dict}, frame: int)
@@ -62,6 +64,7 @@ class HandInProcessBackend:
         self.frame_seconds = self.hand.frame_seconds
         self.friction = self.hand.friction
         self.beta_mm = self.hand.beta_mm
+        self.marker_counts = {name: moved.shape[0] for name, moved in self.hand.markers().items()}
 
     def set_noise_seed(self, noise_seed):
         self.hand.set_noise_seed(-1 if noise_seed is None else int(noise_seed))

@@ -49,11 +49,13 @@ class HandRosBackend(RosClient):
     service_timeout_s: wall seconds to wait for the master, the parameters, hand_sim's services
       and the renderers (a system still starting: the renderers bake their textures first).
     frame_timeout_s: wall seconds to wait for a frame's images once ~step or ~reset returned.
+    markers: also subscribe to every sensor's markers (needed by ``markers``); refused with the
+      reason when a sensor's renderer has no marker grid.
     Raises norm2tex.Error (a RuntimeError) with what to start when the system is not there.
     """
 
     def __init__(self, namespace="/", service_timeout_s=30.0, frame_timeout_s=10.0,
-                 node_name="norm2tex_hand_ros_backend"):
+                 node_name="norm2tex_hand_ros_backend", markers=False):
         from norm2tex.srv import HandReset, HandStep
 
         super().__init__("HandRosBackend", "hand_sim", "hand_sim.launch",
@@ -94,6 +96,21 @@ class HandRosBackend(RosClient):
 
         self._images = [self.topic(s + "/image_raw") for s in self.sensor_names]
         self._subscribe(self._images + [self.topic(s + "/background") for s in self.sensor_names])
+        # Each sensor's renderer reads its own ~sensor (a mount's sensor_yaml, or the launch's);
+        # read only when asked (the renderers' files; a backend elsewhere may not have them).
+        self.marker_counts = None
+        self._markers = [self.topic(s + "/markers") for s in self.sensor_names] if markers else None
+        if markers:
+            self.marker_counts = {s: self._marker_count(s + "_renderer") for s in self.sensor_names}
+            bare = [s for s in self.sensor_names if self.marker_counts[s] == 0]
+            if bare:
+                self.close()
+                raise self.error("markers=True, but the sensor of %s (%s) has no marker grid "
+                                 "(its yaml's markers: enabled: false); launch with a sensor that "
+                                 "has one, e.g. sensor:=$(rospack find norm2tex)/config/"
+                                 "gelsight_mini.yaml" % (bare[0],
+                                                         self._renderer_sensor(bare[0] + "_renderer")))
+            self._subscribe(self._markers, self._markers_type())
         # The frame the backend is at (after a reset or step): its stamp, number and state.
         self._stamp = self._frame = self._state = None
         self._backgrounds = {}
@@ -146,6 +163,16 @@ class HandRosBackend(RosClient):
         msgs = self._wait_for(self._images, self._stamp, "images")
         return {name: bgr8(m, t) for name, m, t in zip(self.sensor_names, msgs, self._images)}
 
+    def markers(self):
+        """{sensor: (markers, 2) float32 mm, gel frame}: each marker's displacement at the
+        current frame (needs markers=True)."""
+        if self._markers is None:
+            raise self.error("markers need HandRosBackend(markers=True)")
+        if self._stamp is None:
+            raise self.error("no frame yet; call reset() first")
+        msgs = self._wait_for(self._markers, self._stamp, "markers")
+        return {name: self._displacements(m) for name, m in zip(self.sensor_names, msgs)}
+
     def background(self, sensor):
         """(rows, cols, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""
         if sensor not in self._backgrounds:
@@ -166,6 +193,9 @@ class HandRosBackend(RosClient):
                    "normal_force_n": float(s.normal_force[i]),
                    "shear_force_n": np.array([s.shear_force[i].x, s.shear_force[i].y,
                                               s.shear_force[i].z]),
+                   "pressure_centre_m": np.array([s.pressure_centre[i].x,
+                                                  s.pressure_centre[i].y]),
+                   "twist_moment_nm": float(s.twist_moment[i]),
                    "penetration_m": float(s.penetration[i]),
                    "too_deep": bool(s.too_deep[i]),
                    "object_in_gel": _matrix(s.object_in_gel[i])}

@@ -23,7 +23,8 @@ class InProcessBackend:
       step_one(i, mode, value, frames=1)  # gripper i alone (the others stand still)
       images(finger) -> (N, rows, cols, 3) uint8     finger: "left" / "right"
       depths(finger) -> (N, rows, cols) float32 m
-      markers(finger) -> (N, markers, 2) float32 mm    (in-process only)
+      marker_count                      (markers per gel; 0: the sensor has no marker grid)
+      markers(finger) -> (N, markers, 2) float32 mm    (RosBackend: with markers=True)
       background(finger) -> (rows, cols, 3) uint8    (no contact, no noise)
       state() -> dict of arrays: opening, commanded_opening (N,), normal_force_n,
                  penetration_m, in_contact (N, 2), dropped (N,), frame (N,)
@@ -79,6 +80,7 @@ class InProcessBackend:
             o.physics_rate_hz = float(physics_rate_hz)
             options.append(o)
         self.batch = norm2tex.TactileGripperBatch(scene_config, sensor_model, options, threads)
+        self.marker_count = self.batch.markers("left")["displacement_mm"].shape[1]
         self.size = count
         self.has_materials = [bool(p) for p in paths]
         self.has_material = any(self.has_materials)

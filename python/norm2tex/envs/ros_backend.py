@@ -22,6 +22,8 @@ It has InProcessBackend's interface for count 1 (see its docstring; ``step_one(0
     ``noise_per_episode`` is False).
   - ``depths`` needs ``depth=True`` at construction (the renderers publish depth only to
     subscribers, so the depth of a frame exists only if someone listened when it was rendered).
+  - ``markers`` needs ``markers=True`` at construction and renderers whose sensor has a marker
+    grid (they publish /digit_*/markers with every frame).
   - ``prefetch_variant`` does nothing: a renderer prepares a new variant at the episode's first
     frame (the first reset with a new variant takes as long as generating it, ~0.5 s).
   - construction starts no episode: call ``reset`` first (the launch's own first episode,
@@ -46,11 +48,13 @@ class RosBackend(RosClient):
       services (a system still starting: the renderers bake their textures first).
     frame_timeout_s: wall seconds to wait for a frame's images once ~step or ~reset returned.
     depth: also subscribe to /digit_*/depth (needed by ``depths``).
+    markers: also subscribe to /digit_*/markers (needed by ``markers``); refused with the reason
+      when the renderers' sensor has no marker grid.
     Raises norm2tex.Error (a RuntimeError) with what to start when the system is not there.
     """
 
     def __init__(self, namespace="/", service_timeout_s=30.0, frame_timeout_s=10.0, depth=False,
-                 node_name="norm2tex_ros_backend"):
+                 node_name="norm2tex_ros_backend", markers=False):
         from norm2tex.msg import GripperCommand
         from norm2tex.srv import Reset, Step
 
@@ -90,6 +94,19 @@ class RosBackend(RosClient):
         kinds = ("image_raw", "depth") if depth else ("image_raw",)
         self._subscribe([self._topic(f, k) for f in FINGERS for k in kinds + ("background",)])
         self._depth = bool(depth)
+        # Each renderer reads its own ~sensor; the left one stands for both (as for the beta).
+        # Read only when asked: the yaml is the renderers' file, which a backend on another
+        # machine may not have.
+        self._markers = bool(markers)
+        self.marker_count = self._marker_count("digit_left_renderer") if self._markers else None
+        if self._markers:
+            if self.marker_count == 0:
+                self.close()
+                raise self.error("markers=True, but the renderers' sensor (%s) has no marker grid "
+                                 "(its yaml's markers: enabled: false); launch with a sensor that "
+                                 "has one, e.g. sensor:=$(rospack find norm2tex)/config/"
+                                 "gelsight_mini.yaml" % self._renderer_sensor("digit_left_renderer"))
+            self._subscribe([self._topic(f, "markers") for f in FINGERS], self._markers_type())
         self._stamp = None  # the frame the backend is at (after a reset or step)
         self._state = None
         self._backgrounds = {}
@@ -214,6 +231,14 @@ class RosBackend(RosClient):
         rows = np.frombuffer(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
         depth = rows[:, : msg.width * 4].copy().view(dtype).astype(np.float32)
         return depth.reshape(1, msg.height, msg.width)
+
+    def markers(self, finger):
+        """(1, markers, 2) float32: each marker's displacement on the gel at the current frame,
+        mm, gel frame (needs markers=True)."""
+        self._check_finger(finger)
+        if not self._markers:
+            raise self.error("markers need RosBackend(markers=True)")
+        return self._displacements(self._frame_msg(finger, "markers"))[None]
 
     def background(self, finger):
         """(rows, cols, 3) uint8: the sensor's no-contact frame without noise (latched topic)."""

@@ -132,12 +132,14 @@ class RosClient:
                 raise self.error("%s failed: %s; is %s still running?"
                                  % (full, error, self._launch)) from None
 
-    def _subscribe(self, topics):
-        """Keeps the latest sensor_msgs/Image of each topic, once every one is connected (frames
-        published before a subscription is connected are not delivered)."""
-        from sensor_msgs.msg import Image
+    def _subscribe(self, topics, msg_type=None):
+        """Keeps the latest message (a sensor_msgs/Image unless msg_type says otherwise) of each
+        topic, once every one is connected (frames published before a subscription is connected
+        are not delivered)."""
+        if msg_type is None:
+            from sensor_msgs.msg import Image as msg_type
 
-        subscribers = [self._rospy.Subscriber(t, Image, self._receive, callback_args=t,
+        subscribers = [self._rospy.Subscriber(t, msg_type, self._receive, callback_args=t,
                                               queue_size=None, buff_size=1 << 24,
                                               tcp_nodelay=True) for t in topics]
         self._subscribers += subscribers
@@ -147,6 +149,29 @@ class RosClient:
                     raise self.error("%s has no publisher within %.0f s; are the renderers of "
                                      "this launch running?" % (sub.name, self._service_timeout_s))
                 time.sleep(0.01)
+
+    def _renderer_sensor(self, renderer):
+        """The sensor yaml a renderer of the launch reads (its ~sensor; default the DIGIT's)."""
+        return self.param(renderer + "/sensor", "") or norm2tex.config_path("digit.yaml")
+
+    def _marker_count(self, renderer):
+        """How many markers a renderer's sensor has (0: no marker grid); it publishes
+        <sensor>/markers with every frame when it has some."""
+        model = norm2tex.SensorModel.load(self._renderer_sensor(renderer))
+        rows, cols = model.marker_grid
+        return rows * cols if model.markers_enabled else 0
+
+    @staticmethod
+    def _markers_type():
+        from norm2tex.msg import TactileMarkers
+
+        return TactileMarkers
+
+    @staticmethod
+    def _displacements(msg):
+        """(markers, 2) float32 mm, gel frame: a TactileMarkers message's displacement_mm."""
+        return np.array([(d.x, d.y) for d in msg.displacement_mm],
+                        dtype=np.float32).reshape(-1, 2)
 
     def _receive(self, msg, topic):
         with self._cond:
