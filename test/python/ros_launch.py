@@ -21,6 +21,19 @@ def free_port(script=None):
     return int(out)
 
 
+def digit_yaml(**settings):
+    """The shipped DIGIT with SensorModel attributes changed (e.g. markers_enabled=True), saved
+    to a new temporary directory for a launch's sensor:= and the in-process side to share."""
+    import norm2tex
+
+    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
+    for name, value in settings.items():
+        setattr(model, name, value)
+    path = os.path.join(tempfile.mkdtemp(prefix="norm2tex_test_sensor_"), "digit.yaml")
+    model.save(path)
+    return path
+
+
 def start(args, env, log):
     """`roslaunch args...` in a process group of its own, output to the open file `log`."""
     return subprocess.Popen(["roslaunch"] + list(args), env=env, stdout=log,

@@ -7,7 +7,6 @@ Starts its own master on a free port (scripts/free_port). Run (with the workspac
     /usr/bin/python3 -m pytest -q test/python/test_hand_ros_backend.py
 """
 import os
-import tempfile
 
 import numpy as np
 import pytest
@@ -37,13 +36,7 @@ POSE_TOLERANCE = 1e-12
 def sensor_yaml():
     """The default DIGIT with its marker grid drawn: both sides render the gels' lateral motion
     from the physics' tangential forces and twists."""
-    import norm2tex
-
-    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
-    model.markers_enabled = True
-    path = os.path.join(tempfile.mkdtemp(prefix="norm2tex_hand_ros_backend_sensor_"), "digit.yaml")
-    model.save(path)
-    return path
+    return ros_launch.digit_yaml(markers_enabled=True)
 
 
 @pytest.fixture(scope="module")

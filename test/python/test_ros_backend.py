@@ -6,8 +6,6 @@ in-process; and RosBackend's refusals carry contact_sim's reasons.
 Starts its own master on a free port (scripts/free_port). Run (with the workspace sourced):
     /usr/bin/python3 -m pytest -q test/python/test_ros_backend.py
 """
-import os
-import tempfile
 import time
 
 import numpy as np
@@ -30,14 +28,7 @@ def sensor_yaml():
     """The default DIGIT with the texture's conformity on and its marker grid drawn: both sides
     must then pass the gels' normal forces, tangential forces and twists to their renderers
     (contact_sim in SimFrame) to agree."""
-    import norm2tex
-
-    model = norm2tex.SensorModel.load(norm2tex.config_path("digit.yaml"))
-    model.conformity_enabled = True
-    model.markers_enabled = True
-    path = os.path.join(tempfile.mkdtemp(prefix="norm2tex_ros_backend_sensor_"), "digit.yaml")
-    model.save(path)
-    return path
+    return ros_launch.digit_yaml(conformity_enabled=True, markers_enabled=True)
 
 
 @pytest.fixture(scope="module")
