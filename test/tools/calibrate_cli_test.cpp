@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -22,6 +23,19 @@
 #include "norm2tex/shear/marker_pattern.hpp"
 
 namespace {
+
+/// The gel of press i of a 6 mm ball (3 mm radius) whose contact circle is centred centre_mm from
+/// the image centre, its radius growing with i (1.1 mm + 0.12 mm per press), and that circle.
+std::pair<cv::Mat1f, norm2tex::PressCircle> ballPress(const norm2tex::SensorModel& m,
+                                                      cv::Point2d centre_mm, int i) {
+  const norm2tex::PressCircle circle{
+      {centre_mm.x / m.mm_per_pixel + (m.cols - 1) / 2.0,
+       centre_mm.y / m.mm_per_pixel + (m.rows - 1) / 2.0},
+      (1.1 + 0.12 * i) / m.mm_per_pixel};
+  cv::Mat1f gel;
+  norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+  return {gel, circle};
+}
 using norm2tex::test::CliRun;
 
 CliRun calibrate(const std::string& arguments) {
@@ -43,11 +57,7 @@ class CalibrateCli : public norm2tex::test::CliTest {
     labels << "file,centre_x_px,centre_y_px,radius_px\n";
     const cv::Point2d centres_mm[] = {{-3, -5}, {2, -4}, {0, 0}, {-2, 3}, {3, 4}, {1, 6}};
     for (int i = 0; i < 6; ++i) {
-      const norm2tex::PressCircle circle{
-          {centres_mm[i].x / m.mm_per_pixel + 119.5, centres_mm[i].y / m.mm_per_pixel + 159.5},
-          (1.1 + 0.12 * i) / m.mm_per_pixel};
-      cv::Mat1f gel;
-      norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+      const auto [gel, circle] = ballPress(m, centres_mm[i], i);
       const std::string name = "press" + std::to_string(i) + ".png";
       cv::imwrite(path(name), shader.shade(gel, 10 + i));
       presses_ += " " + path(name);
@@ -158,11 +168,7 @@ TEST_F(CalibrateCli, AGelSightMiniCalibratesFromLandscapeFramesWithItsYaml) {
   std::string presses;
   const cv::Point2d centres_mm[] = {{-5, -3}, {4, -3}, {0, 0}, {-3, 3}, {5, 3}, {1, -4}};
   for (int i = 0; i < 6; ++i) {
-    const norm2tex::PressCircle circle{
-        {centres_mm[i].x / m.mm_per_pixel + 159.5, centres_mm[i].y / m.mm_per_pixel + 119.5},
-        (1.1 + 0.12 * i) / m.mm_per_pixel};
-    cv::Mat1f gel;
-    norm2tex::GelModel(m).apply(norm2tex::ballPressIndentation(m, circle, 3.0), gel);
+    const cv::Mat1f gel = ballPress(m, centres_mm[i], i).first;
     const std::string name = path("mini_press" + std::to_string(i) + ".png");
     const cv::Mat3b press = shader.shade(gel, 20 + i);
     cv::imwrite(name, marked(press));
