@@ -44,6 +44,7 @@ import sys
 import tempfile
 import time
 import unittest
+import unittest.mock
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_docs as docs  # noqa: E402  (the pages and their fenced blocks)
@@ -336,11 +337,14 @@ def shortest_form(command):
 
 
 def substituted(command, page, page_dir):
+    """The command as run: the page's own /data/ and /tmp/ paths moved into the page's directory,
+    then its placeholders replaced. In that order: a placeholder's value is a real path already
+    (a fixture of a clone that may itself live under /tmp)."""
     subs = SUBSTITUTIONS.get(page, {})
-    words = [subs.get(w, w) for w in _words(command)]
-    text = " ".join(words)
-    return re.sub(r"(^|[\s=])/(data|tmp)/", lambda m: "%s%s/%s/" % (m.group(1), page_dir,
-                                                                      m.group(2)), text)
+    moved = [re.sub(r"(^|[\s=])/(data|tmp)/", lambda m: "%s%s/%s/" % (m.group(1), page_dir,
+                                                                   m.group(2)), w)
+             for w in _words(command)]
+    return " ".join(subs.get(w, w) for w in moved)
 
 
 def outputs(command):
@@ -565,6 +569,14 @@ class ParsingTest(unittest.TestCase):
         self.assertEqual(cmd, 'norm2tex_render --mesh sphere:5 --pose "0 0 0.005 0 0 0" '
                               '-o out.png --json /T/tmp/x.json')
         self.assertEqual(outputs(cmd), ["out.png", "/T/tmp/x.json"])
+
+    def test_a_placeholders_path_under_tmp_is_kept(self):
+        # A clone under /tmp (as CI's is) has its fixtures there: they are not the page's /tmp.
+        fixture = "/tmp/clone/test/fixtures/robots/wsg50/digit.STL"
+        with unittest.mock.patch.dict(SUBSTITUTIONS, {"docs/materials.md": {"IN.stl": fixture}}):
+            self.assertEqual(substituted("norm2tex_texgen --mesh IN.stl -o /tmp/n.png",
+                                         "docs/materials.md", "/T"),
+                             "norm2tex_texgen --mesh %s -o /T/tmp/n.png" % fixture)
 
     def test_exclusion_prefix(self):
         self.assertIsNotNone(exclusion("roslaunch norm2tex gripper_sim.launch"))
