@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -94,6 +95,18 @@ struct ObjectCollision {
 /// finger sits back from the commanded position by F / k (F the mean gel force), reached by one
 /// Newton step of the series equilibrium per tick; k = 0 is rigid.
 ///
+/// A two-finger hand of your own (GripperOptions::hand_yaml, scene yaml gripper.hand): its
+/// two DIGITs (the first the left finger's) must face each other across the fingers and its
+/// gripper.joints be prismatic joints that move the gels along that axis, centred. GripperSim
+/// measures the hand at gripper.closed and gripper.open and works in its grip frame: origin
+/// midway between the open gels' centres, y from the right gel to the left, z the world's up
+/// made square to y (so the grip axis must not be within 60 degrees of vertical). The gripper
+/// section of config() then holds the hand's values: the gaps measured, base_height_m the grip
+/// frame's height, force, speed and stiffness per finger from its drives (a drive moving both
+/// fingers through a mimic joint counts half). Episodes, openings and the drop latch are as
+/// for the built-in gripper, in that frame; the gels' heights across it are their pads'
+/// extents along z.
+///
 /// Deterministic: the same config, reset seeds and commands give bit-identical trajectories.
 class GripperSim {
  public:
@@ -101,7 +114,8 @@ class GripperSim {
   /// lowest height offset of heightOffsetRange() and the fingers open; call reset() to start an episode.
   /// Throws Error for an invalid config, an unreadable mesh, an object wider than max_gap (or
   /// too thin for the closed gripper to reach the grip), or one whose sides miss the gel pads
-  /// at every height offset of the scene.
+  /// at every height offset of the scene; with a hand, for a hand yaml HandSim refuses, and
+  /// for a hand that is not a parallel gripper as described above (naming what is not).
   explicit GripperSim(const GripperSimConfig& config);
   ~GripperSim();
   GripperSim(const GripperSim&) = delete;
@@ -146,15 +160,25 @@ class GripperSim {
 
   const GelContactState& contact(Finger finger) const;
   Eigen::Isometry3d objectInWorld() const;
+  /// The gripper base in the world: (0, 0, base_height) unrotated; a hand's root link pose.
   Eigen::Isometry3d baseInWorld() const;
-  /// Finger frame in the base frame: (0, +-position, 0), no rotation.
+  /// Finger frame in the base frame: (0, +-position, 0), no rotation; on a hand, the pose of
+  /// the link that carries the finger's DIGIT.
   Eigen::Isometry3d fingerInBase(Finger finger) const;
-  /// Gel frame in its finger frame (a fixed rotation).
+  /// The built-in gripper's gel frame in its finger frame (a fixed rotation).
   static Eigen::Isometry3d gelInFinger(Finger finger);
+  /// The grip frame in the world (see the class comment): (0, 0, base_height) unrotated for the
+  /// built-in gripper.
+  Eigen::Isometry3d gripInWorld() const { return grip_in_world_; }
+  /// True for a hand of your own (GripperOptions::hand_yaml), false for the built-in gripper.
+  bool hasOwnHand() const { return !config_.gripper.hand_yaml.empty(); }
+  /// The hand that runs it (the built-in gripper's or yours).
+  const HandSim& hand() const { return *hand_; }
   Eigen::Isometry3d gelInWorld(Finger finger) const;
   /// Prismatic joint position of a finger: distance of its undeformed gel surface from the
   /// centre plane, metres (both fingers are equal: they are coupled). Where the finger is, not
-  /// where it is commanded: a compliant drive leaves it further out.
+  /// where it is commanded: a compliant drive leaves it further out. On a hand: half the gap
+  /// between its undeformed gel surfaces along the grip axis.
   double fingerPosition() const;
   /// Latched once the object has left both gels and fallen below their lower edge at the end of
   /// a tick; cleared by reset().
@@ -167,6 +191,15 @@ class GripperSim {
   const ObjectCollision& collision() const;
 
  private:
+  /// Runs a hand of your own: builds it, measures its grip frame and stroke, and fills the
+  /// config's gripper section with them.
+  void useOwnHand();
+  /// The gripper joints' targets for a normalised opening.
+  std::vector<double> jointTargets(double opening) const;
+  /// The gripper joints' positions at opening 1.
+  std::vector<double> openJointPositions() const;
+  /// Ticks the drives need to reach the command's targets from where they are.
+  int ticksToArrive() const;
   void findHeightOffsetRange();
   /// The object frame's pose with its body (its bounds' centre) `offset_m` above the gel
   /// centres, unrotated.
@@ -181,7 +214,15 @@ class GripperSim {
 
   GripperSimConfig config_;
   std::unique_ptr<HandSim> hand_;
-  int finger_joint_ = 0;  ///< the left finger's joint, the drive's (the right one mimics it)
+  int finger_joint_ = 0;  ///< the built-in left finger's joint, the drive's (the right mimics it)
+  /// The joints the opening drives: the built-in gripper's finger_left_joint, or the hand's
+  /// gripper.joints, with their positions at opening 0 and 1 (a hand's).
+  std::vector<std::string> gripper_joints_;
+  std::vector<int> gripper_joint_indices_;
+  std::vector<double> joints_closed_, joints_open_;
+  Eigen::Isometry3d grip_in_world_ = Eigen::Isometry3d::Identity();
+  /// Half the gel pads' extent along the grip frame's z (the lower of the two gels').
+  double pad_half_height_m_ = 0.0;
   std::pair<double, double> height_offset_range_;
   double command_ = 1.0;
   std::uint32_t episode_ = 0;

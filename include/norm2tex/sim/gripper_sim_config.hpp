@@ -11,6 +11,10 @@ namespace norm2tex {
 /// The parallel gripper: a base fixed in the world and two fingers on one prismatic axis,
 /// coupled so they stay centred. Each finger carries a DIGIT whose gel faces the other finger.
 struct GripperOptions {
+  /// A two-finger hand of your own (scene yaml gripper.hand: a hand yaml, docs/hands.md) instead
+  /// of the built-in gripper; empty: the built-in one. With a hand the fields below are the
+  /// hand's, measured by GripperSim from its URDF and yaml (the yaml may not give them).
+  std::string hand_yaml;
   double base_height_m = 0.20;  ///< gel centres above the world's floor (z = 0), metres
   /// Gap between the two undeformed gel surfaces at opening 0 (closed) and 1 (fully open), m.
   double min_gap_m = 0.0;

@@ -102,6 +102,7 @@ class HandSim {
   /// The drive's effort and velocity limits and stiffness per joint (URDF or yaml).
   double jointEffort(int joint) const { return drives_[joint].effort; }
   double jointVelocity(int joint) const { return drives_[joint].velocity; }
+  double jointStiffness(int joint) const { return drives_[joint].stiffness; }
 
   /// Sets targets for named actuated joints (the others keep theirs); stops any trajectory.
   /// Targets outside the URDF limits are clamped: returns the names of those clamped. Throws

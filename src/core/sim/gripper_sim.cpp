@@ -96,13 +96,29 @@ HandSimConfig builtInHand(const GripperSimConfig& scene) {
 
 GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   validate(config_);
-  hand_ = std::make_unique<HandSim>(builtInHand(config_), builtInHandDescription(config_.gripper));
-  finger_joint_ = hand_->description().jointIndex(kFingerJoint);
+  if (hasOwnHand()) {
+    useOwnHand();
+  } else {
+    hand_ =
+        std::make_unique<HandSim>(builtInHand(config_), builtInHandDescription(config_.gripper));
+    finger_joint_ = hand_->description().jointIndex(kFingerJoint);
+    gripper_joints_ = {kFingerJoint};
+    gripper_joint_indices_ = {finger_joint_};
+    grip_in_world_ = Eigen::Translation3d(0.0, 0.0, config_.gripper.base_height_m);
+    pad_half_height_m_ = config_.gel_height_m / 2;
+  }
+  // What the stroke is called in messages: the scene's keys, or the hand's yaml.
+  const std::string open_gap = hasOwnHand()
+                                   ? "the hand's open gap (" + config_.gripper.hand_yaml + ")"
+                                   : std::string("gripper.max_gap_mm");
+  const std::string closed_gap = hasOwnHand()
+                                     ? "the hand's closed gap (" + config_.gripper.hand_yaml + ")"
+                                     : std::string("gripper.min_gap_mm");
   if (objectWidthM() + 2 * kSeatClearance > config_.gripper.max_gap_m) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
-            << " mm wide along the grip axis: more than gripper.max_gap_mm = "
-            << config_.gripper.max_gap_m * 1e3 << " minus 2 mm of clearance";
+            << " mm wide along the grip axis: more than " << open_gap << " = "
+            << config_.gripper.max_gap_m * 1e3 << " mm minus 2 mm of clearance";
     throw Error(message.str());
   }
   const EpisodeOptions& e = config_.episode;
@@ -112,8 +128,8 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   if (e.grasp_opening < 0 && objectWidthM() - 2 * grip_reach < config_.gripper.min_gap_m) {
     std::ostringstream message;
     message << "object '" << config_.object.mesh << "' is " << objectWidthM() * 1e3
-            << " mm wide along the grip axis: the closed gripper (gripper.min_gap_mm = "
-            << config_.gripper.min_gap_m * 1e3 << ") cannot indent both gels " << grip_depth * 1e3
+            << " mm wide along the grip axis: the closed gripper (" << closed_gap << " = "
+            << config_.gripper.min_gap_m * 1e3 << " mm) cannot indent both gels " << grip_depth * 1e3
             << " mm into it";
     if (grip_reach > grip_depth) {
       message << " (its drive would have to close " << (grip_reach - grip_depth) * 1e3
@@ -123,9 +139,162 @@ GripperSim::GripperSim(const GripperSimConfig& config) : config_(config) {
   }
   findHeightOffsetRange();
   // The object at the lowest offset, the fingers open.
-  hand_->reset(seatedObjectPose(height_offset_range_.first), {kFingerJoint},
-               {config_.gripper.max_gap_m / 2.0});
+  hand_->reset(seatedObjectPose(height_offset_range_.first), gripper_joints_,
+               openJointPositions());
   command(1.0);
+}
+
+void GripperSim::useOwnHand() {
+  const std::string& yaml = config_.gripper.hand_yaml;
+  HandConfig hand = loadHandConfig(yaml);
+  const auto refuse = [&](const std::string& why) {
+    throw Error("hand '" + yaml + "' as a gripper: " + why);
+  };
+  if (hand.sensors.size() != 2) {
+    refuse("a gripper's hand carries two DIGITs (sensors: the left finger's, then the right's); "
+           "it has " + std::to_string(hand.sensors.size()));
+  }
+  if (hand.gripper_joints.empty()) {
+    refuse("its yaml names no gripper.joints (the joints that open and close it, with their "
+           "positions closed and open)");
+  }
+  gripper_joints_ = hand.gripper_joints;
+  joints_closed_ = hand.gripper_closed;
+  joints_open_ = hand.gripper_open;
+  HandSimConfig sim = makeHandSimConfig(std::move(hand), config_);
+  sim.object_pose = sim.hand.base_pose;  // seated below, once the hand is measured
+  hand_ = std::make_unique<HandSim>(sim);
+  const HandDescription& description = hand_->description();
+  for (const std::string& name : gripper_joints_) {
+    const int j = description.jointIndex(name);
+    if (description.joints[j].type != HandJoint::Type::kPrismatic) {
+      refuse("gripper joint '" + name + "' is not prismatic: GripperSim's episodes are a " +
+             "parallel gripper's (HandEnv drives any hand)");
+    }
+    gripper_joint_indices_.push_back(j);
+  }
+
+  // The gels' centres and normals at a normalised opening, the object where it is.
+  struct Gels {
+    Eigen::Vector3d left, right, left_normal, right_normal;
+  };
+  const Eigen::Isometry3d object = hand_->objectInWorld();
+  const auto gelsAt = [&](double opening) {
+    hand_->reset(object, gripper_joints_, jointTargets(opening));
+    const Eigen::Isometry3d l = hand_->gelInWorld(0), r = hand_->gelInWorld(1);
+    return Gels{l.translation(), r.translation(), l.linear().col(2), r.linear().col(2)};
+  };
+  const Gels open = gelsAt(1.0), closed = gelsAt(0.0), half = gelsAt(0.5);
+  const Eigen::Vector3d across = open.left - open.right;
+  if (across.norm() < 1e-3) refuse("its open gels are less than 1 mm apart (gripper.open)");
+  const Eigen::Vector3d y = across.normalized();
+  const auto degrees = [](double cosine) {
+    return std::acos(std::clamp(cosine, -1.0, 1.0)) * 180.0 / M_PI;
+  };
+  // Each gel's normal (its +z, out of the gel) must point at the other finger.
+  constexpr double kMaxTiltDeg = 10.0;
+  const double left_tilt = degrees(-open.left_normal.dot(y));
+  const double right_tilt = degrees(open.right_normal.dot(y));
+  if (left_tilt > kMaxTiltDeg || right_tilt > kMaxTiltDeg) {
+    std::ostringstream message;
+    message << "its gels do not face each other across the fingers: the left gel's normal is "
+            << left_tilt << " degrees and the right's " << right_tilt
+            << " degrees from the line to the other gel (at most " << kMaxTiltDeg
+            << "; sensors: the left finger's first, and their gel: mounts)";
+    refuse(message.str());
+  }
+  const auto gap = [&](const Gels& g) { return (g.left - g.right).dot(y); };
+  const auto middle = [](const Gels& g) -> Eigen::Vector3d { return (g.left + g.right) / 2; };
+  // Closing must move the gels towards each other along that line, both alike, in proportion.
+  constexpr double kMaxDriftM = 0.5e-3;
+  const Eigen::Vector3d closed_across = closed.left - closed.right;
+  const double drift = std::max((middle(closed) - middle(open)).norm(),
+                                (closed_across - closed_across.dot(y) * y).norm());
+  const double bend = std::abs(gap(half) - (gap(closed) + gap(open)) / 2);
+  if (drift > kMaxDriftM || bend > kMaxDriftM) {
+    std::ostringstream message;
+    message << "closing does not move its gels straight towards each other, centred (their "
+            << "midpoint or their line moves " << drift * 1e3 << " mm, the gap at half opening "
+            << "is " << bend * 1e3 << " mm off the mean of closed and open; at most "
+            << kMaxDriftM * 1e3 << " mm): GripperSim's episodes are a parallel gripper's";
+    refuse(message.str());
+  }
+  if (gap(closed) < 0.0) {
+    std::ostringstream message;
+    message << "at gripper.closed its gels overlap by " << -gap(closed) * 1e3
+            << " mm (close less: the gel surfaces meet at gap 0)";
+    refuse(message.str());
+  }
+  // z: the world's up made square to the grip axis.
+  Eigen::Vector3d z = Eigen::Vector3d::UnitZ() - y.z() * y;
+  if (z.norm() < 0.5) {
+    std::ostringstream message;
+    message << "its grip axis is " << degrees(std::abs(y.z()))
+            << " degrees from vertical (at least 30 needed): the episodes hold the object "
+            << "against gravity between the gels";
+    refuse(message.str());
+  }
+  z.normalize();
+  grip_in_world_.linear() << y.cross(z), y, z;
+  grip_in_world_.translation() = middle(open);
+  // How far each pad reaches up and down across the grip axis; the lower of the two.
+  pad_half_height_m_ = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Matrix3d r = hand_->gelInWorld(i).linear();
+    pad_half_height_m_ = std::min(pad_half_height_m_,
+                                  (std::abs(r.col(0).dot(z)) * config_.gel_width_m +
+                                   std::abs(r.col(1).dot(z)) * config_.gel_height_m) / 2);
+  }
+
+  // The gripper section: the hand's. Force, speed and stiffness per finger: a drive that moves
+  // both fingers (one joint, the other mimicking it) counts half of its effort and stiffness.
+  GripperOptions& g = config_.gripper;
+  const double fingers_per_drive = gripper_joints_.size() == 1 ? 2.0 : 1.0;
+  g.min_gap_m = gap(closed);
+  g.max_gap_m = gap(open);
+  g.base_height_m = grip_in_world_.translation().z();
+  g.max_force_n = std::numeric_limits<double>::infinity();
+  g.max_speed_m_s = std::numeric_limits<double>::infinity();
+  g.stiffness_n_per_m = std::numeric_limits<double>::infinity();
+  for (const int j : gripper_joint_indices_) {
+    g.max_force_n = std::min(g.max_force_n, hand_->jointEffort(j) / fingers_per_drive);
+    g.max_speed_m_s = std::min(g.max_speed_m_s, hand_->jointVelocity(j));
+    g.stiffness_n_per_m = std::min(g.stiffness_n_per_m, hand_->jointStiffness(j) / fingers_per_drive);
+  }
+  // (validate()'s ranges for these are the built-in gripper's scene keys; a hand's come from its
+  // URDF and yaml, which HandSim has checked. What the episode asks of the drive is checked.)
+  if (config_.episode.grasp_force_n >= g.max_force_n) {
+    std::ostringstream message;
+    message << "episode.grasp_force_n = " << config_.episode.grasp_force_n
+            << " N is not below its drives' force per finger, " << g.max_force_n << " N";
+    refuse(message.str());
+  }
+}
+
+std::vector<double> GripperSim::jointTargets(double opening) const {
+  // The built-in gripper: the finger joint at half the gap (the scene's stroke).
+  if (!hasOwnHand()) return {gapForOpening(opening) / 2.0};
+  std::vector<double> targets;
+  for (size_t i = 0; i < gripper_joints_.size(); ++i) {
+    targets.push_back(joints_closed_[i] + opening * (joints_open_[i] - joints_closed_[i]));
+  }
+  return targets;
+}
+
+std::vector<double> GripperSim::openJointPositions() const {
+  return hasOwnHand() ? joints_open_ : std::vector<double>{config_.gripper.max_gap_m / 2.0};
+}
+
+int GripperSim::ticksToArrive() const {
+  const std::vector<double> targets = jointTargets(command_);
+  int ticks = 0;
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const int j = gripper_joint_indices_[i];
+    const double travel = std::abs(hand_->driveJointPositions()[j] - targets[i]);
+    ticks = std::max(ticks, static_cast<int>(std::ceil(travel / hand_->jointVelocity(j) /
+                                                       tickSeconds())));
+  }
+  return ticks;
 }
 
 GripperSim::~GripperSim() = default;
@@ -135,7 +304,7 @@ void GripperSim::findHeightOffsetRange() {
   // the grip axis: both sides' bands must overlap the pads' height, or no grasp can be made.
   const EpisodeOptions& e = config_.episode;
   const double reach = config_.gel_law.points().back().first;
-  const double pad = config_.gel_height_m / 2;
+  const double pad = pad_half_height_m_;
   const ObjectMesh& object = hand_->object();
   const Eigen::AlignedBox3d bounds = object.mesh.bounds().cast<double>();
   const Eigen::Vector3d centre = object.mesh.bounds().center().cast<double>();
@@ -185,7 +354,11 @@ double GripperSim::opening() const {
   return (2.0 * fingerPosition() - g.min_gap_m) / (g.max_gap_m - g.min_gap_m);
 }
 
-double GripperSim::fingerPosition() const { return hand_->jointPositions()[finger_joint_]; }
+double GripperSim::fingerPosition() const {
+  if (!hasOwnHand()) return hand_->jointPositions()[finger_joint_];
+  return (hand_->gelInWorld(0).translation() - hand_->gelInWorld(1).translation())
+             .dot(grip_in_world_.linear().col(1)) / 2.0;
+}
 
 void GripperSim::setOpening(double opening) {
   if (!(opening >= 0.0 && opening <= 1.0)) {
@@ -209,14 +382,20 @@ void GripperSim::command(double opening) {
   command_ = opening;
   // Target positions outside the joint's limits are clamped: gapForOpening(1) / 2 may round a
   // hair above max_gap / 2.
-  hand_->setJointTargets({kFingerJoint}, {gapForOpening(opening) / 2.0});
+  hand_->setJointTargets(gripper_joints_, jointTargets(opening));
 }
 
 Eigen::Isometry3d GripperSim::baseInWorld() const {
+  if (hasOwnHand()) return hand_->basePose();
   return Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, config_.gripper.base_height_m));
 }
 
 Eigen::Isometry3d GripperSim::fingerInBase(Finger finger) const {
+  if (hasOwnHand()) {
+    const int sensor = static_cast<int>(finger);
+    const int link = hand_->description().linkIndex(hand_->sensor(sensor).link);
+    return hand_->basePose().inverse() * hand_->linkInWorld(link);
+  }
   const double side = finger == Finger::kLeft ? 1.0 : -1.0;
   return Eigen::Isometry3d(Eigen::Translation3d(0.0, side * fingerPosition(), 0.0));
 }
@@ -262,18 +441,19 @@ double GripperSim::objectWidthM() const {
 
 Eigen::Isometry3d GripperSim::seatedObjectPose(double offset_m) const {
   const Eigen::Vector3d centre = hand_->object().mesh.bounds().center().cast<double>();
-  const Eigen::Isometry3d body(
-      Eigen::Translation3d(0.0, 0.0, config_.gripper.base_height_m + offset_m));
+  // The built-in gripper's grip frame is a translation: (0, 0, base_height + offset) exactly.
+  const Eigen::Isometry3d body = grip_in_world_ * Eigen::Translation3d(0.0, 0.0, offset_m);
   return body * Eigen::Translation3d(-centre);
 }
 
 void GripperSim::step(int ticks) {
-  // Dropped: free of both gels and below their lower edge, at the end of a tick.
-  const double lower_edge = config_.gripper.base_height_m - config_.gel_height_m / 2.0;
+  // Dropped: free of both gels and below their lower edge (in the grip frame), at the end of a
+  // tick.
+  const Eigen::Isometry3d world_in_grip = grip_in_world_.inverse();
   for (int t = 0; t < ticks; ++t) {
     hand_->step(1);
     if (!contact(Finger::kLeft).in_contact && !contact(Finger::kRight).in_contact &&
-        objectInWorld().translation().z() < lower_edge) {
+        (world_in_grip * objectInWorld().translation()).z() < -pad_half_height_m_) {
       dropped_ = true;
     }
   }
@@ -285,11 +465,6 @@ double GripperSim::closeOnTheObject(double offset_m) {
   const GripperOptions& g = config_.gripper;
   const auto openingForGap = [&](double gap) {
     return std::clamp((gap - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0, 1.0);
-  };
-  const auto ticksToArrive = [&] {
-    const double travel =
-        std::abs(hand_->driveJointPositions()[finger_joint_] - gapForOpening(command_) / 2.0);
-    return static_cast<int>(std::ceil(travel / g.max_speed_m_s / tickSeconds()));
   };
   if (e.grasp_opening >= 0.0) {
     command(e.grasp_opening);
@@ -358,7 +533,7 @@ EpisodeStart GripperSim::reset(std::uint64_t seed, std::optional<double> height_
     const double opening = std::clamp(
         (objectWidthM() + 2 * kSeatClearance - g.min_gap_m) / (g.max_gap_m - g.min_gap_m), 0.0,
         1.0);
-    hand_->reset(seatedObjectPose(offset), {kFingerJoint}, {gapForOpening(opening) / 2.0});
+    hand_->reset(seatedObjectPose(offset), gripper_joints_, jointTargets(opening));
     command(opening);
   };
   seat();

@@ -120,8 +120,25 @@ GripperSimConfig loadGripperSimConfig(const std::string& yaml_path) {
     }
     const YAML::Node g = root["gripper"];
     requireKnownKeys(g, "gripper",
-                     {"base_height_mm", "min_gap_mm", "max_gap_mm", "max_force_n", "max_speed_mm_s",
-                      "stiffness_n_per_mm"});
+                     {"hand", "base_height_mm", "min_gap_mm", "max_gap_mm", "max_force_n",
+                      "max_speed_mm_s", "stiffness_n_per_mm"});
+    if (g && g["hand"]) {
+      // The stroke, drive and height are the hand's own (its URDF and yaml): giving them here
+      // too would leave two answers to one question.
+      for (const char* key : {"base_height_mm", "min_gap_mm", "max_gap_mm", "max_force_n",
+                              "max_speed_mm_s", "stiffness_n_per_mm"}) {
+        if (g[key]) {
+          throw Error(std::string("gripper.") + key + " is given with gripper.hand: a hand's " +
+                      "stroke, drives and pose are its own (its URDF, its hand yaml's gripper, " +
+                      "joints and hand.base_pose); remove gripper." + key);
+        }
+      }
+      const std::string hand = g["hand"].as<std::string>();
+      if (hand.empty()) throw Error("gripper.hand is empty; valid: a hand yaml (docs/hands.md)");
+      c.gripper.hand_yaml = std::filesystem::path(hand).is_relative()
+                                ? (std::filesystem::path(yaml_path).parent_path() / hand).string()
+                                : hand;
+    }
     readMm(g, "base_height_mm", c.gripper.base_height_m);
     readMm(g, "min_gap_mm", c.gripper.min_gap_m);
     readMm(g, "max_gap_mm", c.gripper.max_gap_m);
