@@ -89,6 +89,9 @@ void bindSim(py::module& m) {
            "m at a force (N): the inverse of force()")
       .def_property_readonly("points", &GelLaw::points);
   py::class_<GripperOptions>(m, "GripperOptions", "scene yaml section gripper")
+      .def_readwrite("hand_yaml", &GripperOptions::hand_yaml,
+                     "a two-finger hand yaml of your own (gripper.hand), '' for the built-in "
+                     "gripper; with a hand, GripperSim.config's other fields are the hand's")
       .def_readwrite("base_height_m", &GripperOptions::base_height_m)
       .def_readwrite("min_gap_m", &GripperOptions::min_gap_m, "gel gap at opening 0, m")
       .def_readwrite("max_gap_m", &GripperOptions::max_gap_m, "gel gap at opening 1, m")
@@ -178,6 +181,10 @@ void bindSim(py::module& m) {
              return poseToNumpy(s.gelInWorld(fingerFrom(finger)));
            }, py::arg("finger"))
       .def_property_readonly("finger_position_m", &GripperSim::fingerPosition)
+      .def_property_readonly("config", [](const GripperSim& s) { return s.config(); },
+                             "the scene as run (with a hand, its gripper section measured)")
+      .def("grip_in_world", [](const GripperSim& s) { return poseToNumpy(s.gripInWorld()); },
+           "4x4: origin between the open gels, y from the right gel to the left, z up")
       .def_property_readonly("dropped", &GripperSim::dropped,
                              "the object left both gels and fell below them (this episode)")
       .def_property_readonly("height_offset_range", &GripperSim::heightOffsetRange,

@@ -96,6 +96,14 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   GripperSimConfig& config = scene.config;
   ticks_per_frame_ = scene.ticks_per_frame;
   frame_period_ns_ = scene.frame_period_ns;
+  if (!config.gripper.hand_yaml.empty()) {
+    // Its TF tree, joint states and robot_description are the built-in gripper's; a hand's are
+    // its URDF's, which hand_sim publishes.
+    throw Error("scene '" + params_.scene + "' runs a hand of its own (gripper.hand: " +
+                config.gripper.hand_yaml + "): contact_sim publishes the built-in gripper; " +
+                "run the hand with hand_sim.launch hand:=" + config.gripper.hand_yaml +
+                ", or its episodes in-process (GripperEnv, TactileGripper)");
+  }
   sim_ = std::make_unique<GripperSim>(config);
   {
     // For clients (the Python RosBackend), before the services appear: the offsets ~reset
