@@ -100,7 +100,7 @@ struct ObjectCollision {
 /// gripper.joints be prismatic joints that move the gels along that axis, centred. GripperSim
 /// measures the hand at gripper.closed and gripper.open and works in its grip frame: origin
 /// midway between the open gels' centres, y from the right gel to the left, z the world's up
-/// made square to y (so the grip axis must not be within 60 degrees of vertical). The gripper
+/// made square to y (so the grip axis must be 30 degrees or more from vertical). The gripper
 /// section of config() then holds the hand's values: the gaps measured, base_height_m the grip
 /// frame's height, force, speed and stiffness per finger from its drives (a drive moving both
 /// fingers through a mimic joint counts half). Episodes, openings and the drop latch are as
