@@ -26,6 +26,7 @@
 #include "norm2tex/render/object_texture.hpp"
 #include "norm2tex/render/sensor_model.hpp"
 #include "norm2tex/sim/contact_shear_load.hpp"
+#include "norm2tex/sim/hand_sim.hpp"
 #include "norm2tex/sim/tactile_gripper_batch.hpp"
 #include "params.hpp"
 
@@ -96,14 +97,6 @@ ContactSim::ContactSim(ros::NodeHandle nh, ros::NodeHandle private_nh)
   GripperSimConfig& config = scene.config;
   ticks_per_frame_ = scene.ticks_per_frame;
   frame_period_ns_ = scene.frame_period_ns;
-  if (!config.gripper.hand_yaml.empty()) {
-    // Its TF tree, joint states and robot_description are the built-in gripper's; a hand's are
-    // its URDF's, which hand_sim publishes.
-    throw Error("scene '" + params_.scene + "' runs a hand of its own (gripper.hand: " +
-                config.gripper.hand_yaml + "): contact_sim publishes the built-in gripper; " +
-                "run the hand with hand_sim.launch hand:=" + config.gripper.hand_yaml +
-                ", or its episodes in-process (GripperEnv, TactileGripper)");
-  }
   sim_ = std::make_unique<GripperSim>(config);
   {
     // For clients (the Python RosBackend), before the services appear: the offsets ~reset
@@ -195,7 +188,7 @@ void ContactSim::publishStaticTransforms() {
     t.header.stamp = frameStamp();
     t.header.frame_id = kFingerFrames[i];
     t.child_frame_id = kGelFrames[i];
-    t.transform = ros_conversions::toTransformMsg(GripperSim::gelInFinger(static_cast<Finger>(i)));
+    t.transform = ros_conversions::toTransformMsg(sim_->gelInFingerFrame(static_cast<Finger>(i)));
     transforms.push_back(t);
   }
   static_tf_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
@@ -530,8 +523,15 @@ std::uint32_t ContactSim::publishFrame() {
 
   sensor_msgs::JointState joints;
   joints.header.stamp = stamp;
-  joints.name = {"finger_left_joint", "finger_right_joint"};
-  joints.position = {sim_->fingerPosition(), sim_->fingerPosition()};
+  if (sim_->hasOwnHand()) {
+    // A hand's actuated joints by their URDF names (its finger frames are its sensors' links).
+    const HandSim& hand = sim_->hand();
+    joints.name = hand.actuatedJoints();
+    for (const std::string& name : joints.name) joints.position.push_back(hand.jointPosition(name));
+  } else {
+    joints.name = {"finger_left_joint", "finger_right_joint"};
+    joints.position = {sim_->fingerPosition(), sim_->fingerPosition()};
+  }
   joints_pub_.publish(joints);
 
   for (int i = 0; i < 2; ++i) {

@@ -227,7 +227,7 @@ WSG_HAND = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "fixtu
 
 def test_a_scene_with_a_hand_of_its_own_runs_the_episodes_on_it(tmp_path):
     """gripper.hand: TACTO's WSG-50 (10 N per finger) holds the cube, and drops it when opened;
-    the built-in gripper's scene keys are its own measured stroke; over ROS it is refused."""
+    the built-in gripper's scene keys are its own measured stroke."""
     scene = tmp_path / "wsg50_cube.yaml"
     scene.write_text("gripper:\n  hand: %s\nobject:\n  mesh: box:30x30x30\n"
                      "episode:\n  height_offset_mm: [0, 5]\n" % WSG_HAND)
@@ -260,8 +260,7 @@ def test_a_scene_with_a_hand_of_its_own_runs_the_episodes_on_it(tmp_path):
             break
     assert terminated and info["dropped"]
     env.close()
-    with pytest.raises(ValueError, match="runs a hand of its own .*HandEnv"):
-        GripperEnv(scene=str(scene), backend="ros")
+    # Over ROS: test_gripper_hand_ros_backend.py (the same frames from gripper_sim.launch).
 
 
 def test_local_spaces_behave_like_gymnasiums():

@@ -108,23 +108,6 @@ TEST(LaunchFailure, AMissingFileEndsTheLaunchAtOnceWithTheReason) {
       << map_run.output;
 }
 
-TEST(LaunchFailure, AHandsSceneEndsGripperSimLaunchNamingHandSim) {
-  // contact_sim publishes the built-in gripper's frames: a scene with gripper.hand is refused
-  // (its episodes run in-process), and the required node's end ends the launch.
-  const std::string hand =
-      std::string(NORM2TEX_SOURCE_DIR) + "/test/fixtures/robots/wsg50/wsg50_hand.yaml";
-  const fs::path scene = scratch() / "wsg50_scene.yaml";
-  std::ofstream(scene) << "gripper: {hand: " << hand << "}\n";
-  const LaunchRun run = launch("gripper_sim.launch manager:=false scene:=" + scene.string());
-  EXPECT_LT(run.seconds, kEndsBySelfSeconds) << run.output;
-  EXPECT_NE(run.output.find("REQUIRED process [contact_sim"), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("runs a hand of its own (gripper.hand: " + hand +
-                            "): contact_sim publishes the built-in gripper; run the hand with "
-                            "hand_sim.launch hand:=" + hand),
-            std::string::npos)
-      << run.output;
-}
-
 TEST(LaunchFailure, ABadHandEndsHandSimLaunchWithTheReason) {
   // A missing hand yaml (norm2tex_launch_check) or one without sensors (scripts/hand_nodelets)
   // stops roslaunch while it reads the file; what only the simulation finds (a sensor on a link

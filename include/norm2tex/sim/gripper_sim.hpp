@@ -167,6 +167,9 @@ class GripperSim {
   Eigen::Isometry3d fingerInBase(Finger finger) const;
   /// The built-in gripper's gel frame in its finger frame (a fixed rotation).
   static Eigen::Isometry3d gelInFinger(Finger finger);
+  /// The gel frame in the finger frame fingerInBase() places: gelInFinger() for the built-in
+  /// gripper, the DIGIT's mount on its link for a hand (HandSim::gelInLink).
+  Eigen::Isometry3d gelInFingerFrame(Finger finger) const;
   /// The grip frame in the world (see the class comment): (0, 0, base_height) unrotated for the
   /// built-in gripper.
   Eigen::Isometry3d gripInWorld() const { return grip_in_world_; }

@@ -54,7 +54,7 @@ class GripperVectorEnv(spaces.EnvBase):
       beta_mm: texture depth, mm (None: the material's; 0: the textureless sensor).
       scene: config/scenes/<name>.yaml name or a path (the gripper, the object, the episode);
         a scene whose gripper.hand names a two-finger hand yaml (a WSG-50 with two DIGITs, say)
-        runs its episodes on that hand (in-process only; docs/hands.md).
+        runs its episodes on that hand (docs/hands.md).
       sensor: a sensor yaml (default config/digit.yaml).
       friction: Coulomb coefficient (None: the material's).
       noise: image noise on (drawn per episode from its seed) or off. The sensor adds noise on
@@ -146,14 +146,6 @@ class GripperVectorEnv(spaces.EnvBase):
                 raise ValueError("backend 'ros' runs one material: give a name, not a list")
             if self.num_envs != 1:
                 raise ValueError("backend 'ros' drives one running gripper: num_envs must be 1")
-            hand = norm2tex.SceneConfig.load(norm2tex.scene_config(scene)).gripper.hand_yaml
-            if hand:
-                # gripper_sim.launch runs the built-in gripper; a hand runs under hand_sim.launch,
-                # which HandEnv drives.
-                raise ValueError("scene %s runs a hand of its own (gripper.hand: %s): its "
-                                 "episodes run in-process (backend='inprocess'); over ROS, "
-                                 "drive it with HandEnv and hand_sim.launch hand:=%s"
-                                 % (scene, hand, hand))
             from norm2tex.envs.ros_backend import RosBackend
 
             self.backend = RosBackend(**dict(ros_options or {}, markers=self.with_markers))

@@ -417,6 +417,10 @@ Eigen::Isometry3d GripperSim::gelInFinger(Finger finger) {
   return pose;
 }
 
+Eigen::Isometry3d GripperSim::gelInFingerFrame(Finger finger) const {
+  return hasOwnHand() ? hand_->gelInLink(static_cast<int>(finger)) : gelInFinger(finger);
+}
+
 Eigen::Isometry3d GripperSim::gelInWorld(Finger finger) const {
   // The hand's: its link's pose, then the DIGIT's mount in parallel_gripper.yaml (its rotation
   // is gelInFinger's to within 1e-16, the sine of a right angle in double precision).
