@@ -10,6 +10,8 @@ import signal
 import subprocess
 import tempfile
 
+import numpy as np
+
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 
 
@@ -81,3 +83,11 @@ def joined(make, log):
         log.seek(0)
         print(log.read()[-4000:])
         raise
+
+
+def assert_same_gripper_state(a, b, where):
+    """Two gripper backends' state() equal: the measured values exactly, the flags, the frames."""
+    for key in ("opening", "commanded_opening", "normal_force_n", "penetration_m"):
+        np.testing.assert_array_equal(a[key], b[key], err_msg="%s %s" % (where, key))
+    for key in ("in_contact", "dropped", "frame"):
+        assert np.array_equal(a[key], b[key]), (where, key, a[key], b[key])
