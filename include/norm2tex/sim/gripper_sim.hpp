@@ -219,10 +219,9 @@ class GripperSim {
   std::unique_ptr<HandSim> hand_;
   int finger_joint_ = 0;  ///< the built-in left finger's joint, the drive's (the right mimics it)
   /// The joints the opening drives: the built-in gripper's finger_left_joint, or the hand's
-  /// gripper.joints, with their positions at opening 0 and 1 (a hand's).
+  /// gripper.joints.
   std::vector<std::string> gripper_joints_;
   std::vector<int> gripper_joint_indices_;
-  std::vector<double> joints_closed_, joints_open_;
   Eigen::Isometry3d grip_in_world_ = Eigen::Isometry3d::Identity();
   /// Half the gel pads' extent along the grip frame's z (the lower of the two gels').
   double pad_half_height_m_ = 0.0;

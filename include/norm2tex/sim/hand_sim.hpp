@@ -119,6 +119,9 @@ class HandSim {
   /// The parallel-gripper opening (HandConfig::gripper): 0 closed ... 1 open. Throws Error when
   /// the hand yaml names no gripper joints, or for an opening outside [0, 1].
   void setOpening(double opening);
+  /// The gripper joints' positions (HandConfig::gripper_joints) at a normalised opening:
+  /// closed + opening x (open - closed), each; empty when the hand names none.
+  std::vector<double> gripperJointPositions(double opening) const;
 
   /// Moves the hand's root (a floating hand moved by its arm): at once, or, with `duration_s` >
   /// 0, along a straight line (and the shortest rotation) at constant speed over that much

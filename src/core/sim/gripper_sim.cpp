@@ -159,8 +159,6 @@ void GripperSim::useOwnHand() {
            "positions closed and open)");
   }
   gripper_joints_ = hand.gripper_joints;
-  joints_closed_ = hand.gripper_closed;
-  joints_open_ = hand.gripper_open;
   HandSimConfig sim = makeHandSimConfig(std::move(hand), config_);
   sim.object_pose = sim.hand.base_pose;  // seated below, once the hand is measured
   hand_ = std::make_unique<HandSim>(sim);
@@ -274,15 +272,12 @@ void GripperSim::useOwnHand() {
 std::vector<double> GripperSim::jointTargets(double opening) const {
   // The built-in gripper: the finger joint at half the gap (the scene's stroke).
   if (!hasOwnHand()) return {gapForOpening(opening) / 2.0};
-  std::vector<double> targets;
-  for (size_t i = 0; i < gripper_joints_.size(); ++i) {
-    targets.push_back(joints_closed_[i] + opening * (joints_open_[i] - joints_closed_[i]));
-  }
-  return targets;
+  return hand_->gripperJointPositions(opening);
 }
 
 std::vector<double> GripperSim::openJointPositions() const {
-  return hasOwnHand() ? joints_open_ : std::vector<double>{config_.gripper.max_gap_m / 2.0};
+  return hasOwnHand() ? hand_->gripperJointPositions(1.0)
+                      : std::vector<double>{config_.gripper.max_gap_m / 2.0};
 }
 
 int GripperSim::ticksToArrive() const {

@@ -478,11 +478,16 @@ void HandSim::setOpening(double opening) {
     message << "gripper opening " << opening << " is out of range; valid: [0, 1] (0 = closed)";
     throw Error(message.str());
   }
+  setJointTargets(h.gripper_joints, gripperJointPositions(opening));
+}
+
+std::vector<double> HandSim::gripperJointPositions(double opening) const {
+  const HandConfig& h = config_.hand;
   std::vector<double> positions;
   for (size_t i = 0; i < h.gripper_joints.size(); ++i) {
     positions.push_back(h.gripper_closed[i] + opening * (h.gripper_open[i] - h.gripper_closed[i]));
   }
-  setJointTargets(h.gripper_joints, positions);
+  return positions;
 }
 
 void HandSim::setBasePose(const Eigen::Isometry3d& base_in_world, double duration_s) {
