@@ -114,7 +114,7 @@ TEST(GripperOwnHandTest, Wsg50GraspsHoldsAndDropsACubeAsTheGelLawSays) {
   for (const Finger finger : {Finger::kLeft, Finger::kRight}) {
     const GelContactState& c = sim.contact(finger);
     ASSERT_TRUE(c.in_contact);
-    // The scene's 1 mm asks 11.7 N of each gel (the gel law); the WSG-50's drives give 10 N:
+    // The scene's 1 mm asks 12.8 N of each gel (the gel law); the WSG-50's drives give 10 N:
     // the fingers stop where each gel carries that, at the law's depth for 10 N (0.84 mm).
     ASSERT_GT(config.gel_law.force(config.episode.grasp_indentation_m), 10.0);
     EXPECT_NEAR(c.normal_force_n, 10.0, 0.05 * 10.0);

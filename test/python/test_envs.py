@@ -241,7 +241,7 @@ def test_a_scene_with_a_hand_of_its_own_runs_the_episodes_on_it(tmp_path):
 
     env = GripperEnv(scene=str(scene), material="wood", noise=False, action="absolute")
     obs, info = env.reset(seed=1)
-    # The scene's 1 mm grasp asks 11.7 N of each gel: the WSG-50's drive stops at its 10 N.
+    # The scene's 1 mm grasp asks 12.8 N of each gel: the WSG-50's drive stops at its 10 N.
     assert obs["force"] == pytest.approx([10.0, 10.0], rel=0.05)
     assert not info["dropped"]
     # Both DIGITs see the cube: the contact changes the frame over a large area.
